@@ -1,0 +1,63 @@
+#include "controller/device_frame.h"
+
+namespace vmh {
+
+namespace {
+
+constexpr double kMmPerM = 1000.0;
+
+// DH base point (m) that the device frame calls its origin: the wrist centre
+// at q = 0, (l1, 0, l0 - l2) by eq. B.14
+Vec3 device_origin_base_m(const OmniParams& p) {
+  return Vec3(p.l1_m, 0.0, p.l0_m - p.l2_m);
+}
+
+}  // namespace
+
+Joints device_to_dh_joints(const Joints& t) {
+  Joints q = t;
+  q[0] = -t[0];
+  q[2] = t[2] - t[1];
+  return q;
+}
+
+Joints dh_to_device_joints(const Joints& q) {
+  Joints t = q;
+  t[0] = -q[0];
+  t[2] = q[1] + q[2];
+  return t;
+}
+
+Mat3 R_device_base() {
+  Mat3 R;
+  // rows: x_dev = y_base, y_dev = z_base, z_dev = x_base
+  R << 0, 1, 0,  //
+      0, 0, 1,   //
+      1, 0, 0;
+  return R;
+}
+
+Vec3 base_to_device_mm(const OmniParams& p, const Vec3& p_base_m) {
+  return kMmPerM * (R_device_base() * (p_base_m - device_origin_base_m(p)));
+}
+
+Vec3 device_mm_to_base(const OmniParams& p, const Vec3& p_device_mm) {
+  return R_device_base().transpose() * (p_device_mm / kMmPerM) +
+         device_origin_base_m(p);
+}
+
+Vec3 base_to_device_vector(const Vec3& v) { return R_device_base() * v; }
+
+Vec3 device_to_base_vector(const Vec3& v) {
+  return R_device_base().transpose() * v;
+}
+
+Mat3 base_to_device_rotation(const Mat3& R_base) {
+  return R_device_base() * R_base;
+}
+
+Mat3 device_to_base_rotation(const Mat3& R_device) {
+  return R_device_base().transpose() * R_device;
+}
+
+}  // namespace vmh

@@ -1,0 +1,53 @@
+// The OpenHaptics device frame and joint convention, and conversions to and
+// from the DH base frame and DH joint angles of the thesis.
+//
+// Device frame: origin at the wrist centre of the DH zero pose (arm out toward
+// the user, forearm hanging down), x to the user's right, y up, z toward the
+// user; positions in mm. OpenHaptics reports joint 3 as the absolute forearm
+// angle, and turns joint 1 the other way round from the DH q1.
+//
+// How the mapping was found (REFERENCE.md §3, checked in
+// tests/controller/device_frame_test.cc): the OpenHaptics forward kinematics
+//   x = -sin t1 (l1 cos t2 + l2 sin t3)
+//   y = l2 - l2 cos t3 + l1 sin t2
+//   z = cos t1 (l1 cos t2 + l2 sin t3) - l1
+// equals eq. B.14 under
+//   q1 = -t1, q2 = t2, q3 = t3 - t2,
+//   x_dev = y_base, y_dev = z_base - l0 + l2, z_dev = x_base - l1.
+// This rotation is proper (det +1). REFERENCE.md instead pairs x_dev = -y_base
+// with q1 = t1, which fits the positions too but is a reflection (det -1): it
+// would turn the stylus frame left-handed. See docs/errata.md.
+//
+// Gimbal angles (joints 4-6): taken as equal in both conventions. This is
+// *unverified* against a device; hardware bring-up must confirm it.
+#ifndef VMHAPTICS_CONTROLLER_DEVICE_FRAME_H_
+#define VMHAPTICS_CONTROLLER_DEVICE_FRAME_H_
+
+#include "controller/omni_params.h"
+#include "controller/types.h"
+
+namespace vmh {
+
+// Joint angles: device (OpenHaptics) convention <-> DH convention, rad.
+Joints device_to_dh_joints(const Joints& q_device);
+Joints dh_to_device_joints(const Joints& q_dh);
+
+// Rotation taking DH base-frame components to device-frame components.
+Mat3 R_device_base();
+
+// Points: DH base frame (m) <-> device frame (mm).
+Vec3 base_to_device_mm(const OmniParams& params, const Vec3& p_base_m);
+Vec3 device_mm_to_base(const OmniParams& params, const Vec3& p_device_mm);
+
+// Free vectors (directions, forces): DH base frame <-> device frame. Units
+// are unchanged.
+Vec3 base_to_device_vector(const Vec3& v_base);
+Vec3 device_to_base_vector(const Vec3& v_device);
+
+// Rotations (e.g. the stylus frame) expressed in the other frame.
+Mat3 base_to_device_rotation(const Mat3& R_base);
+Mat3 device_to_base_rotation(const Mat3& R_device);
+
+}  // namespace vmh
+
+#endif  // VMHAPTICS_CONTROLLER_DEVICE_FRAME_H_

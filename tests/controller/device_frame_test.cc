@@ -1,0 +1,103 @@
+// Checks of controller/device_frame: the OpenHaptics frame and joint
+// convention against the DH ones.
+#include "controller/device_frame.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "controller/omni_kinematics.h"
+#include "tests/support/random_joints.h"
+
+namespace vmh {
+namespace {
+
+using testing::JointSampler;
+
+TEST(DeviceJoints, RoundTripBothWays) {
+  JointSampler sample(21);
+  for (int k = 0; k < 1000; ++k) {
+    const Joints q = sample.next();
+    EXPECT_LE((device_to_dh_joints(dh_to_device_joints(q)) - q).norm(), 1e-15);
+    EXPECT_LE((dh_to_device_joints(device_to_dh_joints(q)) - q).norm(), 1e-15);
+  }
+}
+
+// joint 3 absolute on the device: t3 = q2 + q3; joint 1 turns the other way
+TEST(DeviceJoints, JointThreeIsAbsoluteAndJointOneReversed) {
+  Joints q;
+  q << 0.1, 0.2, 0.3, 0.4, 0.5, 0.6;
+  const Joints t = dh_to_device_joints(q);
+  EXPECT_DOUBLE_EQ(t[0], -0.1);
+  EXPECT_DOUBLE_EQ(t[1], 0.2);
+  EXPECT_DOUBLE_EQ(t[2], 0.5);
+  EXPECT_EQ(t.tail<3>(), q.tail<3>());
+}
+
+TEST(DeviceFrame, RotationIsProper) {
+  const Mat3 R = R_device_base();
+  EXPECT_LE((R.transpose() * R - Mat3::Identity()).norm(), 0.0);
+  EXPECT_DOUBLE_EQ(R.determinant(), 1.0);
+}
+
+// device axes named in REFERENCE.md §3: y up is base z; z toward the user is
+// base x (the arm's direction at q1 = 0)
+TEST(DeviceFrame, AxesPointWhereTheDocsSay) {
+  EXPECT_EQ(base_to_device_vector(Vec3::UnitZ()), Vec3::UnitY());
+  EXPECT_EQ(base_to_device_vector(Vec3::UnitX()), Vec3::UnitZ());
+  EXPECT_EQ(base_to_device_vector(Vec3::UnitY()), Vec3::UnitX());
+}
+
+TEST(DeviceFrame, PointsRoundTripAndScaleToMm) {
+  OmniParams p;
+  p.l0_m = 0.02;
+  JointSampler sample(22);
+  for (int k = 0; k < 1000; ++k) {
+    const Vec3 x = 0.1 * sample.next().head<3>();
+    EXPECT_LE((device_mm_to_base(p, base_to_device_mm(p, x)) - x).norm(), 1e-15);
+  }
+  // 1 cm along base z is 10 mm along device y
+  const Vec3 a = base_to_device_mm(p, Vec3(0.1, 0, 0));
+  const Vec3 b = base_to_device_mm(p, Vec3(0.1, 0, 0.01));
+  EXPECT_NEAR((b - a - Vec3(0, 10, 0)).norm(), 0.0, 1e-12);
+}
+
+// the device origin is the wrist centre at q = 0, whatever l0
+TEST(DeviceFrame, OriginIsWristCentreAtZeroPose) {
+  OmniParams p;
+  p.l0_m = 0.03;
+  EXPECT_LE(base_to_device_mm(p, omni_fk(p, Joints::Zero()).p_base_m).norm(),
+            1e-12);
+}
+
+// identity: velocities map by the same rotation; a finite difference of the
+// device-frame wrist position over device joint angles equals
+// R_device_base J_pos dq/dt with dq = d(device_to_dh)/dt
+TEST(DeviceFrame, DeviceJacobianByChainRuleMatchesDifferences) {
+  const OmniParams p;
+  JointSampler sample(23);
+  Mat3 dq_dt = Mat3::Identity();  // d(q1,q2,q3)/d(t1,t2,t3)
+  dq_dt << -1, 0, 0,  //
+      0, 1, 0,        //
+      0, -1, 1;
+  const double h = 1e-6;
+  for (int k = 0; k < 200; ++k) {
+    const Joints t = sample.next();
+    const Mat3 J_dev = 1e3 * R_device_base() *
+                       omni_jacobian(p, device_to_dh_joints(t)).block<3, 3>(0, 0) *
+                       dq_dt;
+    for (int i = 0; i < 3; ++i) {
+      Joints tp = t, tm = t;
+      tp[i] += h;
+      tm[i] -= h;
+      const Vec3 d =
+          (base_to_device_mm(p, omni_fk(p, device_to_dh_joints(tp)).p_base_m) -
+           base_to_device_mm(p, omni_fk(p, device_to_dh_joints(tm)).p_base_m)) /
+          (2 * h);
+      EXPECT_LE((J_dev.col(i) - d).norm(), 1e-4) << "mm/rad, joint " << i;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace vmh

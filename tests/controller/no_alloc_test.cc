@@ -1,0 +1,129 @@
+// The kinematics used in the servo loop allocate nothing and throw nothing.
+//
+// This binary compiles the controller sources itself with
+// EIGEN_RUNTIME_NO_MALLOC and a throwing eigen_assert (see
+// tests/CMakeLists.txt), so an Eigen heap allocation while
+// set_is_malloc_allowed(false) is in force throws EigenAssertFailure; and it
+// counts every operator new (tests/support/alloc_counter.cc). The first two
+// tests show that each detector does fire, so a pass below means something.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "controller/device_frame.h"
+#include "controller/omni_kinematics.h"
+#include "tests/support/alloc_counter.h"
+#include "tests/support/eigen_assert_throws.h"
+
+namespace vmh {
+namespace {
+
+using testing::AllocationScope;
+using testing::EigenAssertFailure;
+
+// Eigen's allocation guard, released on scope exit
+struct NoEigenMalloc {
+  NoEigenMalloc() { Eigen::internal::set_is_malloc_allowed(false); }
+  ~NoEigenMalloc() { Eigen::internal::set_is_malloc_allowed(true); }
+};
+
+std::vector<Joints> random_configurations(int n) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  std::vector<Joints> out(static_cast<std::size_t>(n));
+  for (Joints& q : out) {
+    for (int i = 0; i < 6; ++i) q[i] = u(rng);
+  }
+  return out;
+}
+
+TEST(NoAllocDetectors, EigenGuardCatchesADynamicMatrix) {
+  NoEigenMalloc guard;
+  EXPECT_THROW(
+      {
+        Eigen::MatrixXd m(8, 8);
+        m.setZero();
+      },
+      EigenAssertFailure);
+}
+
+TEST(NoAllocDetectors, CounterCatchesOperatorNew) {
+  std::size_t n = 0;
+  {
+    AllocationScope scope;
+    std::vector<double> v(16, 1.0);
+    n = scope.count();
+    EXPECT_EQ(v.size(), 16u);
+  }
+  EXPECT_GE(n, 1u);
+}
+
+// runs f over many configurations with both detectors armed and asserts that
+// neither fired and nothing threw
+template <typename F>
+void expect_no_alloc(F f) {
+  const std::vector<Joints> qs = random_configurations(200);
+  std::size_t allocations = 0;
+  {
+    NoEigenMalloc guard;
+    AllocationScope scope;
+    for (const Joints& q : qs) {
+      EXPECT_NO_THROW(f(q));
+    }
+    allocations = scope.count();
+  }
+  EXPECT_EQ(allocations, 0u);
+}
+
+TEST(NoAlloc, ForwardKinematics) {
+  const OmniParams p;
+  double sink = 0;
+  expect_no_alloc([&](const Joints& q) {
+    OmniFrames frames;
+    omni_frames(p, q, &frames);
+    const OmniPose pose = omni_fk(p, q);
+    sink += pose.p_base_m.sum() + omni_tool_point(p, pose).sum() +
+            frames.T_base[3].translation().x();
+  });
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+TEST(NoAlloc, Jacobian) {
+  const OmniParams p;
+  double sink = 0;
+  expect_no_alloc([&](const Joints& q) {
+    sink += omni_jacobian(p, q).sum() + omni_jacobian_at(p, q, -0.03).sum();
+  });
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+TEST(NoAlloc, InverseKinematics) {
+  const OmniParams p;
+  int found = 0;
+  expect_no_alloc([&](const Joints& q) {
+    const OmniPose pose = omni_fk(p, q);
+    const IkSolutions a = omni_ik_position(p, pose.p_base_m, q);
+    const IkSolutions b = omni_ik_pose(p, pose.p_base_m, pose.R_base, q);
+    found += a.count + b.count + omni_ik_nearest(b, q);
+  });
+  EXPECT_GT(found, 0);
+}
+
+TEST(NoAlloc, DeviceFrameConversions) {
+  const OmniParams p;
+  double sink = 0;
+  expect_no_alloc([&](const Joints& q) {
+    const Joints t = dh_to_device_joints(q);
+    const OmniPose pose = omni_fk(p, device_to_dh_joints(t));
+    const Vec3 mm = base_to_device_mm(p, pose.p_base_m);
+    sink += device_mm_to_base(p, mm).sum() +
+            base_to_device_rotation(pose.R_base).sum() +
+            base_to_device_vector(pose.R_base.col(2)).sum();
+  });
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+}  // namespace
+}  // namespace vmh
