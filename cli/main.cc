@@ -1,0 +1,72 @@
+// vmhaptics: one command line for the testbed. Each verb prints one JSON
+// object on stdout (or writes CSV files); errors are one line on stderr.
+//
+// Exit codes: 0 success, 2 bad usage or bad input, 1 any other failure.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "cli/args.h"
+#include "cli/kin.h"
+
+namespace {
+
+// the first line of a message; the error contract is one line on stderr
+std::string first_line(const std::string& s) {
+  return s.substr(0, s.find('\n'));
+}
+
+// CLI11 reports a misspelt verb only as "A subcommand is required"; walk the
+// verbs given and name the first unknown one, with the choices
+void check_verbs(CLI::App* app, int argc, char** argv) {
+  std::string path = "vmhaptics";
+  for (int i = 1; i < argc && argv[i][0] != '-'; ++i) {
+    const auto subs = app->get_subcommands([](CLI::App*) { return true; });
+    if (subs.empty()) return;
+    CLI::App* next = nullptr;
+    std::string names;
+    for (CLI::App* s : subs) {
+      if (s->get_name() == argv[i]) next = s;
+      names += (names.empty() ? "" : ", ") + s->get_name();
+    }
+    if (next == nullptr) {
+      throw vmh::cli::UsageError("unknown verb '" + std::string(argv[i]) +
+                                 "' for '" + path + "' (expected one of: " +
+                                 names + ")");
+    }
+    path += " " + next->get_name();
+    app = next;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "vmhaptics: virtual-mechanism control of under-actuated haptic devices "
+      "(PHANTOM Omni), after Wickham 2010 and Beckman & Luecke 2008"};
+  app.set_version_flag("--version", std::string(VMH_VERSION));
+  app.require_subcommand(1);
+  vmh::cli::register_kin(&app);
+
+  try {
+    check_verbs(&app, argc, argv);
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "vmhaptics: error: " << first_line(e.what()) << '\n';
+    return 2;
+  } catch (const vmh::cli::UsageError& e) {
+    std::cerr << "vmhaptics: error: " << first_line(e.what()) << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "vmhaptics: error: " << first_line(e.what()) << '\n';
+    return 1;
+  }
+  return 0;
+}
