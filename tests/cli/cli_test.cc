@@ -1,6 +1,7 @@
 // The command line as a user runs it: its JSON contract and its errors.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -25,7 +26,11 @@ struct CliRun {
 
 // runs `vmhaptics <args>` through the shell, capturing stdout and stderr
 CliRun run(const std::string& args) {
-  const std::string err_path = ::testing::TempDir() + "vmh_cli_stderr.txt";
+  // a file of its own: ctest runs the test cases in parallel processes
+  std::string err_path = ::testing::TempDir() + "vmh_cli_stderr_XXXXXX";
+  const int fd = mkstemp(err_path.data());
+  if (fd < 0) return CliRun{};
+  close(fd);
   const std::string cmd =
       std::string(VMH_CLI_PATH) + " " + args + " 2>" + err_path;
   CliRun r;
@@ -40,6 +45,7 @@ CliRun run(const std::string& args) {
   std::stringstream ss;
   ss << err.rdbuf();
   r.err = ss.str();
+  std::remove(err_path.c_str());
   return r;
 }
 
