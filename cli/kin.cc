@@ -21,8 +21,6 @@ namespace {
 
 using json = Json;
 
-constexpr double kMmPerM = 1000.0;
-
 struct KinOptions {
   std::string q;
   std::string convention = "dh";
@@ -53,14 +51,6 @@ OmniParams read_params(const KinOptions& o) {
   return p;
 }
 
-bool within_limits(const OmniParams& p, const Joints& q) {
-  for (int i = 0; i < kOmniJoints; ++i) {
-    const double a = wrap_angle(q[i]);
-    if (a < p.joint_lower_rad[i] || a > p.joint_upper_rad[i]) return false;
-  }
-  return true;
-}
-
 // fields shared by `kin fk` and `kin jac`
 json pose_json(const OmniParams& p, const Joints& q_dh) {
   OmniFrames frames;
@@ -72,7 +62,7 @@ json pose_json(const OmniParams& p, const Joints& q_dh) {
   json out;
   out["q_dh"] = to_json_vector(q_dh);
   out["q_device"] = to_json_vector(dh_to_device_joints(q_dh));
-  out["within_limits"] = within_limits(p, q_dh);
+  out["within_limits"] = omni_within_limits(p, q_dh);
   out["p_base_m"] = to_json_vector(pose.p_base_m);
   out["R_base"] = to_json_rows(pose.R_base);
   out["p_device_mm"] = to_json_vector(base_to_device_mm(p, pose.p_base_m));

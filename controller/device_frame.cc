@@ -4,8 +4,6 @@ namespace vmh {
 
 namespace {
 
-constexpr double kMmPerM = 1000.0;
-
 // DH base point (m) that the device frame calls its origin: the wrist centre
 // at q = 0, (l1, 0, l0 - l2) by eq. B.14
 Vec3 device_origin_base_m(const OmniParams& p) {

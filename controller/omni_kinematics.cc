@@ -22,16 +22,6 @@ constexpr double kSameSolutionRad = 1e-9;
 // angle a shifted by whole turns to lie within pi of ref
 double unwrap_near(double a, double ref) { return ref + wrap_angle(a - ref); }
 
-bool in_limits(const OmniParams& params, const Joints& q) {
-  for (int i = 0; i < kOmniJoints; ++i) {
-    const double a = wrap_angle(q[i]);
-    if (a < params.joint_lower_rad[i] || a > params.joint_upper_rad[i]) {
-      return false;
-    }
-  }
-  return true;
-}
-
 bool same_solution(const Joints& a, const Joints& b) {
   for (int i = 0; i < kOmniJoints; ++i) {
     if (std::abs(wrap_angle(a[i] - b[i])) > kSameSolutionRad) return false;
@@ -46,7 +36,7 @@ void push_unique(const OmniParams& params, const Joints& q, IkSolutions* out) {
   }
   if (out->count >= IkSolutions::kMax) return;
   out->q_dh[out->count] = q;
-  out->within_limits[out->count] = in_limits(params, q);
+  out->within_limits[out->count] = omni_within_limits(params, q);
   ++out->count;
 }
 
@@ -60,6 +50,16 @@ double wrap_angle(double a) {
   double w = std::remainder(a, 2.0 * kPi);
   if (w <= -kPi) w += 2.0 * kPi;
   return w;
+}
+
+bool omni_within_limits(const OmniParams& params, const Joints& q) {
+  for (int i = 0; i < kOmniJoints; ++i) {
+    const double a = wrap_angle(q[i]);
+    if (!(a >= params.joint_lower_rad[i] && a <= params.joint_upper_rad[i])) {
+      return false;
+    }
+  }
+  return true;
 }
 
 std::array<DhRow, kOmniJoints> omni_dh_table(const OmniParams& p) {

@@ -120,8 +120,12 @@ int omni_wrist_angles(const OmniParams& params, const Eigen::Vector3d& q123,
                       const Mat3& R_base, double q4_hint,
                       std::array<Eigen::Vector3d, 2>* q456, bool* singular);
 
-// Wraps an angle to (-pi, pi].
+// Wraps an angle to (-pi, pi]. Non-finite input is returned unchanged.
 double wrap_angle(double a_rad);
+
+// Whether every joint angle, wrapped to (-pi, pi], lies inside the joint
+// ranges of `params` (DH convention). False for non-finite angles.
+bool omni_within_limits(const OmniParams& params, const Joints& q_dh);
 
 }  // namespace vmh
 

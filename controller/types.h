@@ -21,6 +21,9 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 // is stated wherever one is passed
 using Joints = Vec6;
 
+// millimetres per metre: the device frame and OpenHaptics work in mm
+inline constexpr double kMmPerM = 1000.0;
+
 }  // namespace vmh
 
 #endif  // VMHAPTICS_CONTROLLER_TYPES_H_

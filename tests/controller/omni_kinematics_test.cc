@@ -331,6 +331,20 @@ TEST(OmniIk, InkwellPoseIsReachableWithinLimits) {
   EXPECT_GT(s.q_dh[best][2], 0.0);
 }
 
+TEST(OmniLimits, InsideEdgesOutsideWrappedAndNaN) {
+  const OmniParams p;
+  EXPECT_TRUE(omni_within_limits(p, Joints::Zero()));
+  Joints q = Joints::Zero();
+  q[1] = p.joint_upper_rad[1];  // the edge counts as inside
+  EXPECT_TRUE(omni_within_limits(p, q));
+  q[1] = p.joint_upper_rad[1] + 1e-9;
+  EXPECT_FALSE(omni_within_limits(p, q));
+  q[1] = 0.2 + 2 * kPi;  // a whole turn away from an inside angle
+  EXPECT_TRUE(omni_within_limits(p, q));
+  q[1] = std::nan("");
+  EXPECT_FALSE(omni_within_limits(p, q));
+}
+
 TEST(WrapAngle, HalfOpenInterval) {
   EXPECT_DOUBLE_EQ(wrap_angle(kPi), kPi);
   EXPECT_DOUBLE_EQ(wrap_angle(-kPi), kPi);
