@@ -38,8 +38,7 @@ const std::vector<Sample>& samples() {
     const OmniParams params;
     std::mt19937_64 rng(kSeed);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
-    std::uniform_real_distribution<double> noise(-kHintNoiseRad,
-                                                 kHintNoiseRad);
+    std::uniform_real_distribution<double> noise(-kHintNoiseRad, kHintNoiseRad);
     std::vector<Sample> out(kSamples);
     for (Sample& s : out) {
       for (int i = 0; i < kOmniJoints; ++i) {

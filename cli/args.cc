@@ -26,8 +26,7 @@ double to_number(const std::string& option, const std::string& raw,
   char* end = nullptr;
   const double v = std::strtod(item.c_str(), &end);
   if (end == item.c_str() || *end != '\0') {
-    throw UsageError(option + ": " + where + " '" + item +
-                     "' is not a number");
+    throw UsageError(option + ": " + where + " '" + item + "' is not a number");
   }
   if (!std::isfinite(v) || errno == ERANGE) {
     throw UsageError(option + ": " + where + " '" + item +
@@ -56,8 +55,7 @@ std::vector<double> parse_list(const std::string& option,
   std::vector<double> out;
   out.reserve(items.size());
   for (std::size_t i = 0; i < items.size(); ++i) {
-    out.push_back(
-        to_number(option, items[i], "item " + std::to_string(i + 1)));
+    out.push_back(to_number(option, items[i], "item " + std::to_string(i + 1)));
   }
   return out;
 }

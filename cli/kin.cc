@@ -73,9 +73,10 @@ json pose_json(const OmniParams& p, const Joints& q_dh) {
   out["p_tool_device_mm"] = to_json_vector(base_to_device_mm(p, tool));
   json list = json::array();
   for (int i = 0; i <= kOmniJoints; ++i) {
-    list.push_back({{"frame", i},
-                    {"p_base_m", to_json_vector(frames.T_base[i].translation())},
-                    {"R_base", to_json_rows(frames.T_base[i].linear())}});
+    list.push_back(
+        {{"frame", i},
+         {"p_base_m", to_json_vector(frames.T_base[i].translation())},
+         {"R_base", to_json_rows(frames.T_base[i].linear())}});
   }
   out["frames"] = std::move(list);
   return out;
@@ -93,8 +94,7 @@ void run_fk(const KinOptions& o, bool with_jacobian) {
     const Eigen::JacobiSVD<Mat3> svd(J.block<3, 3>(0, 0));
     const Vec3 sv = svd.singularValues();
     out["J_pos_singular_values"] = to_json_vector(sv);
-    out["J_pos_condition"] =
-        sv[2] > 0 ? json(sv[0] / sv[2]) : json(nullptr);
+    out["J_pos_condition"] = sv[2] > 0 ? json(sv[0] / sv[2]) : json(nullptr);
   }
   std::cout << dump_readable(out) << '\n';
 }
@@ -103,14 +103,15 @@ Mat3 read_rotation(const std::string& text) {
   const std::vector<double> v = parse_list("--R-base", text, 9);
   Mat3 R;
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) R(r, c) = v[static_cast<std::size_t>(3 * r + c)];
+    for (int c = 0; c < 3; ++c)
+      R(r, c) = v[static_cast<std::size_t>(3 * r + c)];
   }
   const double ortho = (R.transpose() * R - Mat3::Identity()).norm();
   if (ortho > 1e-6 || R.determinant() < 0) {
     throw UsageError(
         "--R-base: expected a proper rotation (orthonormal rows, det +1), "
-        "got |R^T R - I| = " + std::to_string(ortho) +
-        ", det = " + std::to_string(R.determinant()));
+        "got |R^T R - I| = " +
+        std::to_string(ortho) + ", det = " + std::to_string(R.determinant()));
   }
   return R;
 }

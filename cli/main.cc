@@ -31,8 +31,8 @@ void check_verbs(CLI::App* app, int argc, char** argv) {
     }
     if (next == nullptr) {
       throw vmh::cli::UsageError("unknown verb '" + std::string(argv[i]) +
-                                 "' for '" + path + "' (expected one of: " +
-                                 names + ")");
+                                 "' for '" + path +
+                                 "' (expected one of: " + names + ")");
     }
     path += " " + next->get_name();
     app = next;

@@ -80,7 +80,7 @@ Eigen::Isometry3d dh_transform(const DhRow& row, double q) {
   const double ca = std::cos(row.alpha_rad), sa = std::sin(row.alpha_rad);
   Eigen::Isometry3d T;
   Eigen::Matrix3d R;
-  R << ct, -st, 0.0,        //
+  R << ct, -st, 0.0,          //
       st * ca, ct * ca, -sa,  //
       st * sa, ct * sa, ca;
   T.linear() = R;
@@ -101,8 +101,7 @@ void omni_frames(const OmniParams& params, const Joints& q,
 OmniPose omni_fk(const OmniParams& params, const Joints& q) {
   OmniFrames f;
   omni_frames(params, q, &f);
-  return {f.T_base[kOmniJoints].translation(),
-          f.T_base[kOmniJoints].linear()};
+  return {f.T_base[kOmniJoints].translation(), f.T_base[kOmniJoints].linear()};
 }
 
 Vec3 omni_tool_point(const OmniParams& params, const OmniPose& pose) {
@@ -269,7 +268,8 @@ IkSolutions omni_ik_pose(const OmniParams& params, const Vec3& p,
     out.wrist_singular = out.wrist_singular || singular;
     for (int k = 0; k < n; ++k) {
       Joints q = arm.q_dh[i];
-      for (int j = 0; j < 3; ++j) q[3 + j] = unwrap_near(q456[k][j], near[3 + j]);
+      for (int j = 0; j < 3; ++j)
+        q[3 + j] = unwrap_near(q456[k][j], near[3 + j]);
       push_unique(params, q, &out);
     }
   }

@@ -32,10 +32,10 @@ void OmniParams::validate() const {
                 num(hi) + "]");
   }
   for (int i = 0; i < kOmniActuated; ++i) {
-    require(std::isfinite(motor_torque_limit_Nm[i]) &&
-                motor_torque_limit_Nm[i] > 0,
-            std::string("motor_torque_limit_Nm of ") + joint_name(i) +
-                " must be > 0, got " + num(motor_torque_limit_Nm[i]));
+    require(
+        std::isfinite(motor_torque_limit_Nm[i]) && motor_torque_limit_Nm[i] > 0,
+        std::string("motor_torque_limit_Nm of ") + joint_name(i) +
+            " must be > 0, got " + num(motor_torque_limit_Nm[i]));
   }
   require(std::isfinite(max_force_N) && max_force_N > 0,
           "max_force_N must be > 0, got " + num(max_force_N));
@@ -43,9 +43,9 @@ void OmniParams::validate() const {
               continuous_force_N <= max_force_N,
           "continuous_force_N must be in (0, max_force_N], got " +
               num(continuous_force_N));
-  require(std::isfinite(encoder_counts_per_rev) && encoder_counts_per_rev > 0,
-          "encoder_counts_per_rev must be > 0, got " +
-              num(encoder_counts_per_rev));
+  require(
+      std::isfinite(encoder_counts_per_rev) && encoder_counts_per_rev > 0,
+      "encoder_counts_per_rev must be > 0, got " + num(encoder_counts_per_rev));
   require(gimbal_pot_bits > 0 && gimbal_pot_bits <= 16,
           "gimbal_pot_bits must be in [1, 16], got " +
               std::to_string(gimbal_pot_bits));

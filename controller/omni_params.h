@@ -51,8 +51,8 @@ struct OmniParams {
   // motor torque clamps of the three actuated joints [oh]: 200, 350, 200 mN·m
   std::array<double, kOmniActuated> motor_torque_limit_Nm = {0.200, 0.350,
                                                              0.200};
-  double max_force_N = 3.3;         // peak force at nominal position [oh]
-  double continuous_force_N = 0.88; // continuous force [oh]
+  double max_force_N = 3.3;          // peak force at nominal position [oh]
+  double continuous_force_N = 0.88;  // continuous force [oh]
 
   // -- sensing --
   double encoder_counts_per_rev = 15000.0;  // actuated joints [tsutano]

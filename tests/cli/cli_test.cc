@@ -78,12 +78,14 @@ TEST(CliKin, FkPrintsTheDocumentedFields) {
   // wrist centre by the OpenHaptics closed form, device joint angles
   // (t1, t2, t3) = (-0.1, 0.2, 0.5), mm
   const double l = 133.35, reach = l * std::cos(0.2) + l * std::sin(0.5);
-  const Vec3 expect(std::sin(0.1) * reach, l - l * std::cos(0.5) + l * std::sin(0.2),
+  const Vec3 expect(std::sin(0.1) * reach,
+                    l - l * std::cos(0.5) + l * std::sin(0.2),
                     std::cos(0.1) * reach - l);
   EXPECT_LE((vec3(j["p_device_mm"]) - expect).norm(), 1e-9);
   const Mat3 R = mat3(j["R_base"]);
   EXPECT_LE((R.transpose() * R - Mat3::Identity()).norm(), 1e-12);
-  EXPECT_LE((vec3(j["axis_device"]) - R_device_base() * R.col(2)).norm(), 1e-15);
+  EXPECT_LE((vec3(j["axis_device"]) - R_device_base() * R.col(2)).norm(),
+            1e-15);
 }
 
 TEST(CliKin, DeviceConventionConvertsJointThree) {
@@ -96,7 +98,8 @@ TEST(CliKin, DeviceConventionConvertsJointThree) {
 }
 
 TEST(CliKin, JacobianMatchesTheLibrary) {
-  const CliRun r = run("kin jac --q 0.1,0.2,0.3,0.4,0.5,0.6 --tool-offset-mm -20");
+  const CliRun r =
+      run("kin jac --q 0.1,0.2,0.3,0.4,0.5,0.6 --tool-offset-mm -20");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json j = json::parse(r.out);
   Joints q;
@@ -159,9 +162,12 @@ void expect_usage_error(const std::string& args, const std::string& needle) {
 
 TEST(CliErrors, BadInputIsOneLineNamingTheProblem) {
   expect_usage_error("kin fk --q 0.1,0.2,0.3", "expected 6");
-  expect_usage_error("kin fk --q 0.1,0.2,x,0.4,0.5,0.6", "item 3 'x' is not a number");
-  expect_usage_error("kin fk --q 0.1,0.2,nan,0.4,0.5,0.6", "not a finite number");
-  expect_usage_error("kin fk --q 0.1,0.2,0.3,0.4,0.5,inf", "not a finite number");
+  expect_usage_error("kin fk --q 0.1,0.2,x,0.4,0.5,0.6",
+                     "item 3 'x' is not a number");
+  expect_usage_error("kin fk --q 0.1,0.2,nan,0.4,0.5,0.6",
+                     "not a finite number");
+  expect_usage_error("kin fk --q 0.1,0.2,0.3,0.4,0.5,inf",
+                     "not a finite number");
   expect_usage_error("kin fk --q 0.1,,0.3,0.4,0.5,0.6", "item 2 is empty");
   expect_usage_error("kin fk", "--q");
   expect_usage_error("kin fk --q 0,0,0,0,0,0 --convention xyz", "--convention");
@@ -172,7 +178,8 @@ TEST(CliErrors, BadInputIsOneLineNamingTheProblem) {
   expect_usage_error("kin jac --q 0,0,0,0,0,0 --tool-offset-mm abc",
                      "--tool-offset-mm");
   expect_usage_error("nosuchverb", "unknown verb 'nosuchverb'");
-  expect_usage_error("kin fkk --q 0,0,0,0,0,0", "unknown verb 'fkk' for 'vmhaptics kin'");
+  expect_usage_error("kin fkk --q 0,0,0,0,0,0",
+                     "unknown verb 'fkk' for 'vmhaptics kin'");
 }
 
 TEST(CliErrors, NegativeNumbersAreAccepted) {

@@ -54,7 +54,8 @@ TEST(DeviceFrame, PointsRoundTripAndScaleToMm) {
   JointSampler sample(22);
   for (int k = 0; k < 1000; ++k) {
     const Vec3 x = 0.1 * sample.next().head<3>();
-    EXPECT_LE((device_mm_to_base(p, base_to_device_mm(p, x)) - x).norm(), 1e-15);
+    EXPECT_LE((device_mm_to_base(p, base_to_device_mm(p, x)) - x).norm(),
+              1e-15);
   }
   // 1 cm along base z is 10 mm along device y
   const Vec3 a = base_to_device_mm(p, Vec3(0.1, 0, 0));
@@ -77,15 +78,15 @@ TEST(DeviceFrame, DeviceJacobianByChainRuleMatchesDifferences) {
   const OmniParams p;
   JointSampler sample(23);
   Mat3 dq_dt = Mat3::Identity();  // d(q1,q2,q3)/d(t1,t2,t3)
-  dq_dt << -1, 0, 0,  //
-      0, 1, 0,        //
+  dq_dt << -1, 0, 0,              //
+      0, 1, 0,                    //
       0, -1, 1;
   const double h = 1e-6;
   for (int k = 0; k < 200; ++k) {
     const Joints t = sample.next();
-    const Mat3 J_dev = 1e3 * R_device_base() *
-                       omni_jacobian(p, device_to_dh_joints(t)).block<3, 3>(0, 0) *
-                       dq_dt;
+    const Mat3 J_dev =
+        1e3 * R_device_base() *
+        omni_jacobian(p, device_to_dh_joints(t)).block<3, 3>(0, 0) * dq_dt;
     for (int i = 0; i < 3; ++i) {
       Joints tp = t, tm = t;
       tp[i] += h;

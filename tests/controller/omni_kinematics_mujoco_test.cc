@@ -8,9 +8,8 @@
 // is rewritten as RotX(alpha) TransX(a) TransZ(d) RotZ(theta_offset) RotZ(q)
 // (RotZ and TransZ commute): everything but RotZ(q) is the fixed body pose,
 // and RotZ(q) is a hinge about the body's local z axis.
-#include <mujoco/mujoco.h>
-
 #include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
 
 #include <algorithm>
 #include <array>
@@ -131,8 +130,8 @@ std::string omni_mjcf(const OmniParams& params, double tool_offset_m) {
     const double py = -std::sin(r.alpha_rad) * r.d_m;
     const double pz = std::cos(r.alpha_rad) * r.d_m;
     xml << indent << "<body name=\"link" << i + 1 << "\" pos=\"" << num(px)
-        << ' ' << num(py) << ' ' << num(pz) << "\" euler=\""
-        << num(r.alpha_rad) << " 0 " << num(r.theta_offset_rad) << "\">\n"
+        << ' ' << num(py) << ' ' << num(pz) << "\" euler=\"" << num(r.alpha_rad)
+        << " 0 " << num(r.theta_offset_rad) << "\">\n"
         << indent << "  <joint name=\"q" << i + 1
         << "\" type=\"hinge\" axis=\"0 0 1\" pos=\"0 0 0\"/>\n"
         // small inertia: only kinematics is used, but moving bodies need mass
@@ -159,8 +158,7 @@ ModelPtr load_mjcf(const std::string& xml, std::string* error) {
   std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
   mj_defaultVFS(vfs.get());
   const char* name = "omni_dh_check.xml";
-  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size())) !=
-      0) {
+  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size())) != 0) {
     *error = "mj_makeEmptyFileVFS failed";
     return nullptr;
   }
@@ -262,9 +260,9 @@ class OmniMujocoTest : public ::testing::Test {
       for (int b = 1; b <= kOmniJoints; ++b) {
         const Vec3 p = Eigen::Map<const Vec3>(data_->xpos + 3 * b);
         const Mat3 R = Eigen::Map<const RowMat3>(data_->xmat + 9 * b);
-        e.frames = std::max(
-            {e.frames, max_abs_diff(p, frames.T_base[b].translation()),
-             max_abs_diff(R, frames.T_base[b].linear())});
+        e.frames =
+            std::max({e.frames, max_abs_diff(p, frames.T_base[b].translation()),
+                      max_abs_diff(R, frames.T_base[b].linear())});
       }
 
       // wrist site: site_xpos == omni_fk.p_base_m, site_xmat == R_base
@@ -282,9 +280,9 @@ class OmniMujocoTest : public ::testing::Test {
 
       // tool site: site_xpos == omni_tool_point(omni_fk), and mj_jacSite ==
       // omni_jacobian_at(q, tool_offset_m)
-      e.tool_pos = std::max(e.tool_pos, max_abs_diff(site_pos(tool_),
-                                                     omni_tool_point(params_,
-                                                                     pose)));
+      e.tool_pos = std::max(
+          e.tool_pos,
+          max_abs_diff(site_pos(tool_), omni_tool_point(params_, pose)));
       const Mat6 Jt = omni_jacobian_at(params_, q, params_.tool_offset_m);
       site_jac(tool_, &jacp, &jacr);
       e.tool_jac_lin =
@@ -374,14 +372,14 @@ TEST_F(OmniMujocoTest, HomePoseMatchesAndLengthsMatter) {
 
   OmniParams swapped = params_;
   std::swap(swapped.l1_m, swapped.l2_m);
-  EXPECT_GT(max_abs_diff(site_pos(wrist_),
-                         omni_fk(swapped, Joints::Zero()).p_base_m),
-            1e-3);
+  EXPECT_GT(
+      max_abs_diff(site_pos(wrist_), omni_fk(swapped, Joints::Zero()).p_base_m),
+      1e-3);
   OmniParams no_l0 = params_;
   no_l0.l0_m = 0.0;
-  EXPECT_GT(max_abs_diff(site_pos(wrist_),
-                         omni_fk(no_l0, Joints::Zero()).p_base_m),
-            1e-3);
+  EXPECT_GT(
+      max_abs_diff(site_pos(wrist_), omni_fk(no_l0, Joints::Zero()).p_base_m),
+      1e-3);
 }
 
 // Identities, at kConfigs configurations uniform in [-pi, pi]^6, default

@@ -36,7 +36,8 @@ Vec3 rotation_between(const Mat3& Ra, const Mat3& Rb) {
 
 double angle_distance(const Joints& a, const Joints& b) {
   double d = 0;
-  for (int i = 0; i < 6; ++i) d = std::max(d, std::abs(wrap_angle(a[i] - b[i])));
+  for (int i = 0; i < 6; ++i)
+    d = std::max(d, std::abs(wrap_angle(a[i] - b[i])));
   return d;
 }
 
@@ -123,7 +124,8 @@ void check_jacobian_by_differences(const OmniParams& p, double offset_m,
       qp[i] += h;
       qm[i] -= h;
       const OmniPose a = omni_fk(po, qp), b = omni_fk(po, qm);
-      const Vec3 v = (omni_tool_point(po, a) - omni_tool_point(po, b)) / (2 * h);
+      const Vec3 v =
+          (omni_tool_point(po, a) - omni_tool_point(po, b)) / (2 * h);
       const Vec3 w = rotation_between(b.R_base, a.R_base) / (2 * h);
       worst = std::max(worst, (J.block<3, 1>(0, i) - v).cwiseAbs().maxCoeff());
       worst = std::max(worst, (J.block<3, 1>(3, i) - w).cwiseAbs().maxCoeff());
@@ -176,7 +178,8 @@ TEST(OmniIk, PositionSolutionsReproduceTargetAndNearestIsSource) {
     ASSERT_GE(s.count, 1);
     total += s.count;
     for (int j = 0; j < s.count; ++j) {
-      worst_m = std::max(worst_m, (omni_fk(p, s.q_dh[j]).p_base_m - target).norm());
+      worst_m =
+          std::max(worst_m, (omni_fk(p, s.q_dh[j]).p_base_m - target).norm());
     }
     const int best = omni_ik_nearest(s, q);
     ASSERT_GE(best, 0);
@@ -221,8 +224,8 @@ TEST(OmniIk, SolutionsUnwrapTowardNear) {
   q << 0.3, 0.4, 0.2, 0.1, -0.2, 0.5;
   Joints near = q;
   near.array() += 2 * kPi;
-  const IkSolutions s = omni_ik_pose(p, omni_fk(p, q).p_base_m,
-                                     omni_fk(p, q).R_base, near);
+  const IkSolutions s =
+      omni_ik_pose(p, omni_fk(p, q).p_base_m, omni_fk(p, q).R_base, near);
   const int best = omni_ik_nearest(s, near);
   ASSERT_GE(best, 0);
   EXPECT_LE((s.q_dh[best] - near).cwiseAbs().maxCoeff(), 1e-9);
@@ -242,7 +245,8 @@ TEST(OmniIk, InsideTheInnerHoleIsUnreachable) {
   OmniParams p;
   p.l1_m = 0.14;
   p.l2_m = 0.10;  // nothing closer than 0.04 m to the shoulder is reachable
-  const IkSolutions s = omni_ik_position(p, Vec3(0.01, 0.01, 0.0), Joints::Zero());
+  const IkSolutions s =
+      omni_ik_position(p, Vec3(0.01, 0.01, 0.0), Joints::Zero());
   EXPECT_EQ(s.status, IkStatus::kUnreachable);
   EXPECT_NEAR(s.reach_excess_m, 0.04 - std::sqrt(2) * 0.01, 1e-12);
 }

@@ -50,10 +50,12 @@ TEST(OmniParams, EachBadFieldIsNamed) {
       {"tool_offset_m", [](OmniParams* p) { p->tool_offset_m = INFINITY; }},
       {"q3", [](OmniParams* p) { p->joint_lower_rad[2] = 2.0; }},
       {"q6", [&](OmniParams* p) { p->joint_upper_rad[5] = nan; }},
-      {"motor_torque_limit_Nm", [](OmniParams* p) { p->motor_torque_limit_Nm[0] = 0; }},
+      {"motor_torque_limit_Nm",
+       [](OmniParams* p) { p->motor_torque_limit_Nm[0] = 0; }},
       {"max_force_N", [](OmniParams* p) { p->max_force_N = -1; }},
       {"continuous_force_N", [](OmniParams* p) { p->continuous_force_N = 5; }},
-      {"encoder_counts_per_rev", [](OmniParams* p) { p->encoder_counts_per_rev = 0; }},
+      {"encoder_counts_per_rev",
+       [](OmniParams* p) { p->encoder_counts_per_rev = 0; }},
       {"gimbal_pot_bits", [](OmniParams* p) { p->gimbal_pot_bits = 40; }},
   };
   for (const Case& c : cases) {

@@ -13,9 +13,9 @@ struct EigenAssertFailure : std::logic_error {
 };
 }  // namespace vmh::testing
 
-#define eigen_assert(x)                                          \
-  do {                                                           \
-    if (!(x)) throw ::vmh::testing::EigenAssertFailure(#x);      \
+#define eigen_assert(x)                                     \
+  do {                                                      \
+    if (!(x)) throw ::vmh::testing::EigenAssertFailure(#x); \
   } while (false)
 
 #endif  // VMHAPTICS_TESTS_SUPPORT_EIGEN_ASSERT_THROWS_H_
