@@ -13,16 +13,14 @@ Vec3 device_origin_base_m(const OmniParams& p) {
 }  // namespace
 
 Joints device_to_dh_joints(const Joints& t) {
-  Joints q = t;
-  q[0] = -t[0];
-  q[2] = t[2] - t[1];
+  Joints q;
+  q << -t[0], t[1], t[2] - t[1], -t[3], t[4], -t[5];
   return q;
 }
 
 Joints dh_to_device_joints(const Joints& q) {
-  Joints t = q;
-  t[0] = -q[0];
-  t[2] = q[1] + q[2];
+  Joints t;
+  t << -q[0], q[1], q[1] + q[2], -q[3], q[4], -q[5];
   return t;
 }
 

@@ -4,7 +4,7 @@
 // Device frame: origin at the wrist centre of the DH zero pose (arm out toward
 // the user, forearm hanging down), x to the user's right, y up, z toward the
 // user; positions in mm. OpenHaptics reports joint 3 as the absolute forearm
-// angle, and turns joint 1 the other way round from the DH q1.
+// angle, and turns joints 1, 4 and 6 the other way round from the DH angles.
 //
 // How the mapping was found (REFERENCE.md §3, checked in
 // tests/controller/device_frame_test.cc): the OpenHaptics forward kinematics
@@ -18,8 +18,13 @@
 // with q1 = t1, which fits the positions too but is a reflection (det -1): it
 // would turn the stylus frame left-handed. See docs/errata.md.
 //
-// Gimbal angles (joints 4-6): taken as equal in both conventions. This is
-// *unverified* against a device; hardware bring-up must confirm it.
+// Gimbal angles (joints 4-6): t4 = -q4, t5 = q5, t6 = -q6. Source: the
+// stylus rotation of Ubitrack's PhantomForwardKinematics, arm rotation times
+// RotY(t4) RotX(-t5) RotZ(-t6), whose position part is the formula above.
+// With these signs the DH stylus frame equals that rotation exactly, and at
+// q = 0 it is the identity in the device frame. Ubitrack's printed arm
+// matrix is not orthogonal; RotY(-t1) RotX(-t3) is used instead, and the DH
+// chain reproduces it (docs/kinematics.md). Not yet checked on a device.
 #ifndef VMHAPTICS_CONTROLLER_DEVICE_FRAME_H_
 #define VMHAPTICS_CONTROLLER_DEVICE_FRAME_H_
 

@@ -23,15 +23,44 @@ TEST(DeviceJoints, RoundTripBothWays) {
   }
 }
 
-// joint 3 absolute on the device: t3 = q2 + q3; joint 1 turns the other way
-TEST(DeviceJoints, JointThreeIsAbsoluteAndJointOneReversed) {
+// joint 3 absolute on the device: t3 = q2 + q3; joints 1, 4 and 6 turn the
+// other way
+TEST(DeviceJoints, JointThreeIsAbsoluteAndJointsOneFourSixReversed) {
   Joints q;
   q << 0.1, 0.2, 0.3, 0.4, 0.5, 0.6;
   const Joints t = dh_to_device_joints(q);
-  EXPECT_DOUBLE_EQ(t[0], -0.1);
-  EXPECT_DOUBLE_EQ(t[1], 0.2);
-  EXPECT_DOUBLE_EQ(t[2], 0.5);
-  EXPECT_EQ(t.tail<3>(), q.tail<3>());
+  Joints expect;
+  expect << -0.1, 0.2, 0.5, -0.4, 0.5, -0.6;
+  EXPECT_LE((t - expect).norm(), 1e-15);
+}
+
+Mat3 rot_x(double a) { return Eigen::AngleAxisd(a, Vec3::UnitX()).matrix(); }
+Mat3 rot_y(double a) { return Eigen::AngleAxisd(a, Vec3::UnitY()).matrix(); }
+Mat3 rot_z(double a) { return Eigen::AngleAxisd(a, Vec3::UnitZ()).matrix(); }
+
+// identity: the stylus frame in the device frame equals the OpenHaptics
+// composition (after Ubitrack's PhantomForwardKinematics) of the arm,
+// RotY(-t1) RotX(-t3), and the gimbal, RotY(t4) RotX(-t5) RotZ(-t6)
+TEST(DeviceFrame, StylusRotationEqualsOpenHapticsComposition) {
+  const OmniParams p;
+  JointSampler sample(24);
+  double worst = 0;
+  for (int k = 0; k < 10000; ++k) {
+    const Joints t = sample.next();
+    const Mat3 R_dev =
+        base_to_device_rotation(omni_fk(p, device_to_dh_joints(t)).R_base);
+    const Mat3 ref =
+        rot_y(-t[0]) * rot_x(-t[2]) * rot_y(t[3]) * rot_x(-t[4]) * rot_z(-t[5]);
+    worst = std::max(worst, (R_dev - ref).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LE(worst, 1e-12);
+}
+
+// the stylus frame at q = 0 is the device frame itself
+TEST(DeviceFrame, StylusFrameAtHomeIsTheDeviceFrame) {
+  const OmniParams p;
+  const Mat3 R = base_to_device_rotation(omni_fk(p, Joints::Zero()).R_base);
+  EXPECT_LE((R - Mat3::Identity()).cwiseAbs().maxCoeff(), 1e-15);
 }
 
 TEST(DeviceFrame, RotationIsProper) {
