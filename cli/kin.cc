@@ -19,8 +19,6 @@ namespace vmh::cli {
 
 namespace {
 
-using json = Json;
-
 struct KinOptions {
   std::string q;
   std::string convention = "dh";
@@ -52,14 +50,15 @@ OmniParams read_params(const KinOptions& o) {
 }
 
 // fields shared by `kin fk` and `kin jac`
-json pose_json(const OmniParams& p, const Joints& q_dh) {
+Json pose_json(const OmniParams& p, const Joints& q_dh) {
   OmniFrames frames;
   omni_frames(p, q_dh, &frames);
-  const OmniPose pose = omni_fk(p, q_dh);
+  const OmniPose pose{frames.T_base[kOmniJoints].translation(),
+                      frames.T_base[kOmniJoints].linear()};
   const Vec3 tool = omni_tool_point(p, pose);
   const Mat3 R_dev = base_to_device_rotation(pose.R_base);
 
-  json out;
+  Json out;
   out["q_dh"] = to_json_vector(q_dh);
   out["q_device"] = to_json_vector(dh_to_device_joints(q_dh));
   out["within_limits"] = omni_within_limits(p, q_dh);
@@ -71,7 +70,7 @@ json pose_json(const OmniParams& p, const Joints& q_dh) {
   out["tool_offset_mm"] = p.tool_offset_m * kMmPerM;
   out["p_tool_base_m"] = to_json_vector(tool);
   out["p_tool_device_mm"] = to_json_vector(base_to_device_mm(p, tool));
-  json list = json::array();
+  Json list = Json::array();
   for (int i = 0; i <= kOmniJoints; ++i) {
     list.push_back(
         {{"frame", i},
@@ -85,7 +84,7 @@ json pose_json(const OmniParams& p, const Joints& q_dh) {
 void run_fk(const KinOptions& o, bool with_jacobian) {
   const OmniParams p = read_params(o);
   const Joints q = read_joints("--q", o.q, o.convention);
-  json out = pose_json(p, q);
+  Json out = pose_json(p, q);
   if (with_jacobian) {
     const Mat6 J = omni_jacobian(p, q);
     out["J_base"] = to_json_rows(J);
@@ -94,7 +93,7 @@ void run_fk(const KinOptions& o, bool with_jacobian) {
     const Eigen::JacobiSVD<Mat3> svd(J.block<3, 3>(0, 0));
     const Vec3 sv = svd.singularValues();
     out["J_pos_singular_values"] = to_json_vector(sv);
-    out["J_pos_condition"] = sv[2] > 0 ? json(sv[0] / sv[2]) : json(nullptr);
+    out["J_pos_condition"] = sv[2] > 0 ? Json(sv[0] / sv[2]) : Json(nullptr);
   }
   std::cout << dump_readable(out) << '\n';
 }
@@ -138,13 +137,13 @@ void run_ik(const KinOptions& o) {
           : omni_ik_pose(p, target_base_m, read_rotation(o.R_base), near);
   const int best = omni_ik_nearest(s, near);
 
-  json out;
+  Json out;
   out["status"] = ik_status_name(s.status);
   out["p_base_m"] = to_json_vector(target_base_m);
   out["p_device_mm"] = to_json_vector(base_to_device_mm(p, target_base_m));
   out["near_dh"] = to_json_vector(near);
   out["orientation_given"] = !o.R_base.empty();
-  json sol = json::array(), sol_dev = json::array(), lim = json::array();
+  Json sol = Json::array(), sol_dev = Json::array(), lim = Json::array();
   for (int k = 0; k < s.count; ++k) {
     sol.push_back(to_json_vector(s.q_dh[k]));
     sol_dev.push_back(to_json_vector(dh_to_device_joints(s.q_dh[k])));
@@ -154,7 +153,7 @@ void run_ik(const KinOptions& o) {
   out["solutions_device"] = std::move(sol_dev);
   out["within_limits"] = std::move(lim);
   out["nearest_index"] = best;
-  out["nearest"] = best >= 0 ? to_json_vector(s.q_dh[best]) : json(nullptr);
+  out["nearest"] = best >= 0 ? to_json_vector(s.q_dh[best]) : Json(nullptr);
   out["reach_excess_mm"] = s.reach_excess_m * kMmPerM;
   out["shoulder_singular"] = s.shoulder_singular;
   out["elbow_singular"] = s.elbow_singular;
@@ -164,7 +163,7 @@ void run_ik(const KinOptions& o) {
 
 void run_params() {
   const OmniParams p;
-  json out;
+  Json out;
   out["l0_m"] = p.l0_m;
   out["l1_m"] = p.l1_m;
   out["l2_m"] = p.l2_m;
@@ -176,7 +175,7 @@ void run_params() {
   out["continuous_force_N"] = p.continuous_force_N;
   out["encoder_counts_per_rev"] = p.encoder_counts_per_rev;
   out["gimbal_pot_bits"] = p.gimbal_pot_bits;
-  json dh = json::array();
+  Json dh = Json::array();
   for (const DhRow& r : omni_dh_table(p)) {
     dh.push_back({{"a_m", r.a_m},
                   {"alpha_rad", r.alpha_rad},
