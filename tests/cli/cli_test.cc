@@ -12,6 +12,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "tests/support/openhaptics_reference.h"
 
 namespace vmh {
 namespace {
@@ -75,17 +76,17 @@ TEST(CliKin, FkPrintsTheDocumentedFields) {
   }
   EXPECT_EQ(j["q_dh"].size(), 6u);
   EXPECT_EQ(j["frames"].size(), 7u);
-  // wrist centre by the OpenHaptics closed form, device joint angles
-  // (t1, t2, t3) = (-0.1, 0.2, 0.5), mm
-  const double l = 133.35, reach = l * std::cos(0.2) + l * std::sin(0.5);
-  const Vec3 expect(std::sin(0.1) * reach,
-                    l - l * std::cos(0.5) + l * std::sin(0.2),
-                    std::cos(0.1) * reach - l);
+  // the OpenHaptics reference at the same pose in device joint angles
+  Joints t;
+  t << -0.1, 0.2, 0.5, -0.4, 0.5, -0.6;
+  const Vec3 expect = testing::openhaptics_wrist_mm(t, 133.35, 133.35);
   EXPECT_LE((vec3(j["p_device_mm"]) - expect).norm(), 1e-9);
+  const Mat3 R_dev = testing::openhaptics_stylus_rotation(t);
+  EXPECT_LE((mat3(j["R_device"]) - R_dev).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LE((vec3(j["axis_device"]) - R_dev.col(2)).norm(), 1e-12);
+  EXPECT_LE((joints(j["q_device"]) - t).norm(), 1e-15);
   const Mat3 R = mat3(j["R_base"]);
-  EXPECT_LE((R.transpose() * R - Mat3::Identity()).norm(), 1e-12);
-  EXPECT_LE((vec3(j["axis_device"]) - R_device_base() * R.col(2)).norm(),
-            1e-15);
+  EXPECT_LE((R_device_base() * R - R_dev).cwiseAbs().maxCoeff(), 1e-12);
 }
 
 TEST(CliKin, DeviceConventionConvertsJointThree) {

@@ -34,28 +34,6 @@ TEST(DeviceJoints, JointThreeIsAbsoluteAndJointsOneFourSixReversed) {
   EXPECT_LE((t - expect).norm(), 1e-15);
 }
 
-Mat3 rot_x(double a) { return Eigen::AngleAxisd(a, Vec3::UnitX()).matrix(); }
-Mat3 rot_y(double a) { return Eigen::AngleAxisd(a, Vec3::UnitY()).matrix(); }
-Mat3 rot_z(double a) { return Eigen::AngleAxisd(a, Vec3::UnitZ()).matrix(); }
-
-// identity: the stylus frame in the device frame equals the OpenHaptics
-// composition (after Ubitrack's PhantomForwardKinematics) of the arm,
-// RotY(-t1) RotX(-t3), and the gimbal, RotY(t4) RotX(-t5) RotZ(-t6)
-TEST(DeviceFrame, StylusRotationEqualsOpenHapticsComposition) {
-  const OmniParams p;
-  JointSampler sample(24);
-  double worst = 0;
-  for (int k = 0; k < 10000; ++k) {
-    const Joints t = sample.next();
-    const Mat3 R_dev =
-        base_to_device_rotation(omni_fk(p, device_to_dh_joints(t)).R_base);
-    const Mat3 ref =
-        rot_y(-t[0]) * rot_x(-t[2]) * rot_y(t[3]) * rot_x(-t[4]) * rot_z(-t[5]);
-    worst = std::max(worst, (R_dev - ref).cwiseAbs().maxCoeff());
-  }
-  EXPECT_LE(worst, 1e-12);
-}
-
 // the stylus frame at q = 0 is the device frame itself
 TEST(DeviceFrame, StylusFrameAtHomeIsTheDeviceFrame) {
   const OmniParams p;

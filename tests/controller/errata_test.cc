@@ -25,6 +25,7 @@
 #include "controller/omni_kinematics.h"
 #include "controller/omni_params.h"
 #include "tests/controller/thesis_equations.h"
+#include "tests/support/openhaptics_reference.h"
 
 namespace vmh {
 namespace {
@@ -970,10 +971,7 @@ TEST(FrameMapping, ReferenceMappingIsAReflectionProjectsIsARotation) {
   double worst_det_stylus_ref = 0, worst_det_stylus_project = 0;
   for (int k = 0; k < kSamples; ++k) {
     const Joints t = s.angles();  // OpenHaptics joint angles, t3 absolute
-    const double reach = l1 * std::cos(t[1]) + l2 * std::sin(t[2]);
-    const Vec3 hd(-std::sin(t[0]) * reach,
-                  l2 - l2 * std::cos(t[2]) + l1 * std::sin(t[1]),
-                  std::cos(t[0]) * reach - l1);
+    const Vec3 hd = testing::openhaptics_wrist_mm(t, l1, l2);
 
     // REFERENCE: q1 = t1, q2 = t2, q3 = t3 - t2
     Joints q_ref = t;

@@ -9,24 +9,17 @@
 #include <cmath>
 
 #include "controller/device_frame.h"
+#include "tests/support/openhaptics_reference.h"
 #include "tests/support/random_joints.h"
 
 namespace vmh {
 namespace {
 
 using testing::JointSampler;
+using testing::openhaptics_stylus_rotation;
+using testing::openhaptics_wrist_mm;
 
 constexpr double kPi = 3.14159265358979323846;
-
-// OpenHaptics forward kinematics of the wrist centre (Ubitrack
-// PhantomForwardKinematics), device joint angles t (t3 absolute), device
-// frame, mm
-Vec3 openhaptics_fk_mm(const Joints& t, double l1_mm, double l2_mm) {
-  const double reach = l1_mm * std::cos(t[1]) + l2_mm * std::sin(t[2]);
-  return Vec3(-std::sin(t[0]) * reach,
-              l2_mm - l2_mm * std::cos(t[2]) + l1_mm * std::sin(t[1]),
-              std::cos(t[0]) * reach - l1_mm);
-}
 
 // rotation vector of R_b R_a^T (the rotation taking a to b), base frame
 Vec3 rotation_between(const Mat3& Ra, const Mat3& Rb) {
@@ -42,20 +35,26 @@ double angle_distance(const Joints& a, const Joints& b) {
 }
 
 // identity: omni_fk(device_to_dh(t)) mapped to the device frame equals the
-// OpenHaptics closed form, for 10,000 random device configurations
+// OpenHaptics wrist-centre closed form and stylus rotation, for 10,000 random
+// device configurations
 TEST(OmniFk, DeviceFrameEqualsOpenHapticsClosedForm) {
   const OmniParams p;
   JointSampler sample(1);
-  double worst_mm = 0;
+  double worst_mm = 0, worst_rot = 0;
   for (int k = 0; k < 10000; ++k) {
     const Joints t = sample.next();
-    const Vec3 fk_mm =
-        base_to_device_mm(p, omni_fk(p, device_to_dh_joints(t)).p_base_m);
-    const Vec3 ref_mm = openhaptics_fk_mm(t, p.l1_m * 1e3, p.l2_m * 1e3);
-    worst_mm = std::max(worst_mm, (fk_mm - ref_mm).norm());
+    const OmniPose pose = omni_fk(p, device_to_dh_joints(t));
+    const Vec3 ref_mm =
+        openhaptics_wrist_mm(t, p.l1_m * kMmPerM, p.l2_m * kMmPerM);
+    worst_mm = std::max(worst_mm,
+                        (base_to_device_mm(p, pose.p_base_m) - ref_mm).norm());
+    worst_rot = std::max(worst_rot, (base_to_device_rotation(pose.R_base) -
+                                     openhaptics_stylus_rotation(t))
+                                        .cwiseAbs()
+                                        .maxCoeff());
   }
-  // 1e-9 m
-  EXPECT_LE(worst_mm, 1e-6);
+  EXPECT_LE(worst_mm, 1e-6);  // 1e-9 m
+  EXPECT_LE(worst_rot, 1e-12);
 }
 
 // identity: the home pose q = 0 is the device-frame origin, stylus toward the
