@@ -214,13 +214,15 @@ int omni_wrist_angles(const OmniParams& params, const Eigen::Vector3d& q123,
   if (!q123.allFinite() || !R_base.allFinite() || !std::isfinite(q4_hint)) {
     return 0;
   }
-  Joints q = Joints::Zero();
-  q.head<3>() = q123;
-  OmniFrames f;
-  omni_frames(params, q, &f);
+  // only the arm links 1-3 are needed for R_03
+  const std::array<DhRow, kOmniJoints> table = omni_dh_table(params);
+  const Mat3 R03 =
+      (dh_transform(table[0], q123[0]) * dh_transform(table[1], q123[1]) *
+       dh_transform(table[2], q123[2]))
+          .linear();
   // R_36 = R_03^T R_06 has the structure of eq. B.12:
   //   col 3 = (c4 c5, s5, s4 c5), row 2 = (c5 s6, c5 c6, s5)
-  const Mat3 R36 = f.T_base[3].linear().transpose() * R_base;
+  const Mat3 R36 = R03.transpose() * R_base;
   const double s5 = std::max(-1.0, std::min(1.0, R36(1, 2)));
   const double c5_abs = std::hypot(R36(0, 2), R36(2, 2));
   if (c5_abs > kWristEps) {
