@@ -205,18 +205,17 @@ void register_kin(CLI::App* app) {
       "kin", "kinematics of the PHANTOM Omni (Appendix B), JSON on stdout");
   kin->require_subcommand(1);
 
-  CLI::App* fk = kin->add_subcommand("fk", "forward kinematics of every frame");
-  fk->add_option("--q", opts->q, "six joint angles q1,...,q6 (rad)")
-      ->required();
-  add_convention(fk, opts.get());
-  fk->callback([opts] { run_fk(*opts, false); });
-
-  CLI::App* jac = kin->add_subcommand(
-      "jac", "forward kinematics and the 6x6 geometric Jacobian");
-  jac->add_option("--q", opts->q, "six joint angles q1,...,q6 (rad)")
-      ->required();
-  add_convention(jac, opts.get());
-  jac->callback([opts] { run_fk(*opts, true); });
+  // fk and jac take the same options; jac adds the Jacobian to the output
+  const auto add_fk_verb = [&](const char* name, const char* help,
+                               bool with_jacobian) {
+    CLI::App* cmd = kin->add_subcommand(name, help);
+    cmd->add_option("--q", opts->q, "six joint angles q1,...,q6 (rad)")
+        ->required();
+    add_convention(cmd, opts.get());
+    cmd->callback([opts, with_jacobian] { run_fk(*opts, with_jacobian); });
+  };
+  add_fk_verb("fk", "forward kinematics of every frame", false);
+  add_fk_verb("jac", "forward kinematics and the 6x6 geometric Jacobian", true);
 
   CLI::App* ik = kin->add_subcommand(
       "ik", "every joint solution for a wrist-centre position (Pieper)");
