@@ -56,86 +56,73 @@ const std::vector<Sample>& samples() {
   return set;
 }
 
-void BM_omni_fk(benchmark::State& state) {
-  const OmniParams params;
+// cycles through the fixed sample set, one call of f per iteration
+template <typename F>
+void over_samples(benchmark::State& state, F f) {
   const std::vector<Sample>& set = samples();
   std::size_t i = 0;
   for (auto _ : state) {
-    OmniPose pose = omni_fk(params, set[i].q);
-    benchmark::DoNotOptimize(pose);
+    f(set[i]);
     i = (i + 1) & (kSamples - 1);
   }
   state.SetItemsProcessed(state.iterations());
+}
+
+void BM_omni_fk(benchmark::State& state) {
+  const OmniParams params;
+  over_samples(state, [&](const Sample& s) {
+    OmniPose pose = omni_fk(params, s.q);
+    benchmark::DoNotOptimize(pose);
+  });
 }
 BENCHMARK(BM_omni_fk);
 
 void BM_omni_jacobian(benchmark::State& state) {
   const OmniParams params;
-  const std::vector<Sample>& set = samples();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    Mat6 J = omni_jacobian(params, set[i].q);
+  over_samples(state, [&](const Sample& s) {
+    Mat6 J = omni_jacobian(params, s.q);
     benchmark::DoNotOptimize(J);
-    i = (i + 1) & (kSamples - 1);
-  }
-  state.SetItemsProcessed(state.iterations());
+  });
 }
 BENCHMARK(BM_omni_jacobian);
 
 void BM_omni_ik_position(benchmark::State& state) {
   const OmniParams params;
-  const std::vector<Sample>& set = samples();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    IkSolutions sol =
-        omni_ik_position(params, set[i].pose.p_base_m, set[i].near);
+  over_samples(state, [&](const Sample& s) {
+    IkSolutions sol = omni_ik_position(params, s.pose.p_base_m, s.near);
     benchmark::DoNotOptimize(sol);
-    i = (i + 1) & (kSamples - 1);
-  }
-  state.SetItemsProcessed(state.iterations());
+  });
 }
 BENCHMARK(BM_omni_ik_position);
 
 void BM_omni_ik_pose(benchmark::State& state) {
   const OmniParams params;
-  const std::vector<Sample>& set = samples();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    IkSolutions sol = omni_ik_pose(params, set[i].pose.p_base_m,
-                                   set[i].pose.R_base, set[i].near);
+  over_samples(state, [&](const Sample& s) {
+    IkSolutions sol =
+        omni_ik_pose(params, s.pose.p_base_m, s.pose.R_base, s.near);
     benchmark::DoNotOptimize(sol);
-    i = (i + 1) & (kSamples - 1);
-  }
-  state.SetItemsProcessed(state.iterations());
+  });
 }
 BENCHMARK(BM_omni_ik_pose);
 
 // the selection step alone, over precomputed pose solutions
 void BM_omni_ik_nearest(benchmark::State& state) {
-  const std::vector<Sample>& set = samples();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    int best = omni_ik_nearest(set[i].pose_solutions, set[i].near);
+  over_samples(state, [&](const Sample& s) {
+    int best = omni_ik_nearest(s.pose_solutions, s.near);
     benchmark::DoNotOptimize(best);
-    i = (i + 1) & (kSamples - 1);
-  }
-  state.SetItemsProcessed(state.iterations());
+  });
 }
 BENCHMARK(BM_omni_ik_nearest);
 
 // what a servo tick pays: solve the pose, then keep the nearest branch
 void BM_omni_ik_pose_nearest(benchmark::State& state) {
   const OmniParams params;
-  const std::vector<Sample>& set = samples();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    const IkSolutions sol = omni_ik_pose(params, set[i].pose.p_base_m,
-                                         set[i].pose.R_base, set[i].near);
-    int best = omni_ik_nearest(sol, set[i].near);
+  over_samples(state, [&](const Sample& s) {
+    const IkSolutions sol =
+        omni_ik_pose(params, s.pose.p_base_m, s.pose.R_base, s.near);
+    int best = omni_ik_nearest(sol, s.near);
     benchmark::DoNotOptimize(best);
-    i = (i + 1) & (kSamples - 1);
-  }
-  state.SetItemsProcessed(state.iterations());
+  });
 }
 BENCHMARK(BM_omni_ik_pose_nearest);
 
