@@ -1,0 +1,79 @@
+// The pieces of the virtual-mechanism control law, as free functions so that
+// each can be tested on its own: VM placement by weighted Gauss-Newton
+// (eq. 3.14-3.16) and the motion-force projection (eq. 3.11 with Appendix D's
+// weight W_A).
+//
+// All vectors are in the device frame and in the caller's length unit
+// (rows 0-2) and rad (rows 3-5). Nothing here allocates or throws.
+#ifndef VMHAPTICS_CONTROLLER_CONTROL_LAW_H_
+#define VMHAPTICS_CONTROLLER_CONTROL_LAW_H_
+
+#include <cstdint>
+
+#include "controller/virtual_mechanism.h"
+
+namespace vmh {
+
+// bit j set: VM joint j is held fixed (e.g. a sticking contact point)
+using JointMask = std::uint32_t;
+
+// Copies the columns of J whose bit in `locked` is clear into *out.
+void active_columns(const VmJacobian& J, JointMask locked, VmJacobian* out);
+
+// ------------------------------------------------------------- placement
+
+struct PlacementOptions {
+  // diagonal of W in eq. 3.15: (x, y, z, theta_x, theta_y, theta_z).
+  // (1,1,1,0,0,0) is W_p (eq. 3.21: nearest point, the thesis's theta_V);
+  // (0,0,0,1,1,1) is W_o (eq. 3.17: aligned with the stylus, theta_R).
+  Vec6 weights = (Vec6() << 1, 1, 1, 0, 0, 0).finished();
+  double tolerance = 1e-10;  // stop when max |delta theta| falls below this
+  int max_iterations = 20;
+  // Levenberg damping, relative to the mean diagonal of J^T W J; it keeps
+  // joints that W does not see (the twist under W_p) where they are
+  double relative_damping = 1e-12;
+};
+
+struct PlacementResult {
+  int iterations = 0;
+  bool converged = false;
+  double cost = 0.0;  // r^T W r at the returned theta
+};
+
+// The placement residual r(theta) = X_R - X_V(theta): the position
+// difference, and the rotation vector carrying the VM's link axis onto the
+// stylus axis (minus the geometric orientation error). Gauss-Newton needs a
+// residual whose derivative is J_V, so placement always uses this geometric
+// form, whichever error formulation the force law uses (docs/control.md).
+Vec6 placement_residual(const VirtualMechanism& vm, const RmPose& rm,
+                        const VmAngles& theta);
+
+// Iterates eq. 3.15/3.16, delta = (J^T W J)^-1 J^T W r, theta += delta,
+// from *theta (the warm start) and leaves the result in *theta, normalised.
+PlacementResult place_gauss_newton(const VirtualMechanism& vm,
+                                   const RmPose& rm,
+                                   const PlacementOptions& options,
+                                   JointMask locked, VmAngles* theta);
+
+// ------------------------------------------------------------- projection
+
+struct ProjectionResult {
+  // smallest over largest eigenvalue of J^T W_A J (1 for a 1-DOF VM)
+  double rcond = 1.0;
+  bool singular = false;  // rcond below the threshold: regularised
+};
+
+// f = (I - W_A J (J^T W_A J)^-1 J^T) g (eq. 3.11; Appendix D's W_A). The
+// inverse is regularised: each eigenvalue s of J^T W_A J is inverted as
+// s / (s^2 + rho^2) with rho = damping * s_max: 1/s to a relative
+// (damping / rcond)^2 (1e-6 at the Controller's defaults wherever the result
+// is not flagged singular), going smoothly to 0 as s does.
+// `projector`, if given, receives the 6 x 6 matrix.
+ProjectionResult project_motion_force(const VmJacobian& J, const Vec6& W_A,
+                                      const Vec6& g, double singular_rcond,
+                                      double damping, Vec6* f,
+                                      Mat6* projector = nullptr);
+
+}  // namespace vmh
+
+#endif  // VMHAPTICS_CONTROLLER_CONTROL_LAW_H_

@@ -1,0 +1,381 @@
+#include "controller/controller.h"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "controller/device_frame.h"
+#include "controller/omni_kinematics.h"
+
+namespace vmh {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void require(bool ok, const std::string& field, const std::string& what) {
+  if (!ok) {
+    throw std::invalid_argument("controller parameter " + field + ": " + what);
+  }
+}
+
+bool all_finite_nonnegative(const Vec6& v) {
+  return v.allFinite() && (v.array() >= 0.0).all();
+}
+
+}  // namespace
+
+const char* error_formulation_name(ErrorFormulation f) {
+  return f == ErrorFormulation::kThesis ? "thesis" : "geometric";
+}
+
+bool parse_error_formulation(const char* text, ErrorFormulation* f) {
+  if (std::strcmp(text, "thesis") == 0) {
+    *f = ErrorFormulation::kThesis;
+    return true;
+  }
+  if (std::strcmp(text, "geometric") == 0) {
+    *f = ErrorFormulation::kGeometric;
+    return true;
+  }
+  return false;
+}
+
+const char* placement_method_name(PlacementMethod m) {
+  return m == PlacementMethod::kGaussNewton ? "gauss-newton" : "closed";
+}
+
+bool parse_placement_method(const char* text, PlacementMethod* m) {
+  if (std::strcmp(text, "gauss-newton") == 0) {
+    *m = PlacementMethod::kGaussNewton;
+    return true;
+  }
+  if (std::strcmp(text, "closed") == 0) {
+    *m = PlacementMethod::kClosedForm;
+    return true;
+  }
+  return false;
+}
+
+const char* status_flag_name(ControlStatus flag) {
+  switch (flag) {
+    case kStatusOk:
+      return "ok";
+    case kStatusInvalidInput:
+      return "invalid_input";
+    case kStatusNumericalFault:
+      return "numerical_fault";
+    case kStatusOutsideJointLimits:
+      return "outside_joint_limits";
+    case kStatusVmSingular:
+      return "vm_singular";
+    case kStatusPlacementNotConverged:
+      return "placement_not_converged";
+    case kStatusRmAtPivot:
+      return "rm_at_pivot";
+    case kStatusOrientationDegenerate:
+      return "orientation_degenerate";
+    case kStatusForceSaturated:
+      return "force_saturated";
+    case kStatusTorqueSaturated:
+      return "torque_saturated";
+    case kStatusContactSliding:
+      return "contact_sliding";
+    case kStatusContactOpen:
+      return "contact_open";
+    default:
+      return "unknown";
+  }
+}
+
+double thesis_orientation_gain(double multiple_N_per_mm, double length_mm) {
+  return multiple_N_per_mm * 2.0 * kPi * length_mm;
+}
+
+void ControllerParams::validate() const {
+  omni.validate();
+  require(vm.pivot_mm.allFinite(), "vm.pivot_mm", "must be finite");
+  require(vm.R_pivot.allFinite() &&
+              (vm.R_pivot.transpose() * vm.R_pivot).isIdentity(1e-9) &&
+              std::abs(vm.R_pivot.determinant() - 1.0) < 1e-9,
+          "vm.R_pivot", "must be a rotation matrix");
+  require(std::isfinite(vm.length_mm) && vm.length_mm > 0.0, "vm.length_mm",
+          "must be finite and > 0");
+  require(!std::isnan(vm.friction_mu) && vm.friction_mu >= 0.0,
+          "vm.friction_mu", "must be >= 0 (inf: never slides)");
+  const double gains_list[] = {gains.k_pos_N_per_mm, gains.k_ornt_Nmm_per_rad,
+                               gains.k_vel_Ns_per_mm,
+                               gains.k_vel_ornt_Nmms_per_rad};
+  const char* gain_names[] = {"gains.k_pos_N_per_mm",
+                              "gains.k_ornt_Nmm_per_rad",
+                              "gains.k_vel_Ns_per_mm",
+                              "gains.k_vel_ornt_Nmms_per_rad"};
+  for (int i = 0; i < 4; ++i) {
+    require(std::isfinite(gains_list[i]) && gains_list[i] >= 0.0,
+            gain_names[i], "must be finite and >= 0");
+  }
+  require(all_finite_nonnegative(placement_options.weights),
+          "placement_options.weights", "must be finite and >= 0");
+  require(placement_options.weights.sum() > 0.0, "placement_options.weights",
+          "must not all be zero");
+  require(std::isfinite(placement_options.tolerance) &&
+              placement_options.tolerance > 0.0,
+          "placement_options.tolerance", "must be finite and > 0");
+  require(placement_options.max_iterations >= 1,
+          "placement_options.max_iterations", "must be >= 1");
+  require(std::isfinite(placement_options.relative_damping) &&
+              placement_options.relative_damping >= 0.0,
+          "placement_options.relative_damping", "must be finite and >= 0");
+  require(projection_weights.allFinite() &&
+              (projection_weights.array() > 0.0).all(),
+          "projection_weights", "must be finite and > 0");
+  require(std::isfinite(length_unit_mm) && length_unit_mm > 0.0,
+          "length_unit_mm", "must be finite and > 0");
+  require(std::isfinite(servo_period_s) && servo_period_s > 0.0,
+          "servo_period_s", "must be finite and > 0");
+  require(std::isfinite(velocity_cutoff_Hz), "velocity_cutoff_Hz",
+          "must be finite (<= 0 turns the filter off)");
+  require(std::isfinite(singular_rcond) && singular_rcond > 0.0 &&
+              singular_rcond < 1.0,
+          "singular_rcond", "must be in (0, 1)");
+  require(std::isfinite(singular_damping) && singular_damping >= 0.0,
+          "singular_damping", "must be finite and >= 0");
+  require(std::isfinite(force_limit_N) && force_limit_N > 0.0,
+          "force_limit_N", "must be finite and > 0");
+}
+
+Controller::Controller(const ControllerParams& params) : params_(params) {
+  params_.validate();
+  const double u = params_.length_unit_mm;
+  VmMount mount;
+  mount.origin = params_.vm.pivot_mm / u;
+  mount.R = params_.vm.R_pivot;
+  const double L = params_.vm.length_mm / u;
+  switch (params_.vm.kind) {
+    case VmKind::kCircle:
+      vm_ = std::make_unique<CircleVm>(mount, L);
+      break;
+    case VmKind::kSphere:
+      vm_ = std::make_unique<SphereVm>(mount, L);
+      break;
+    case VmKind::kSurface:
+      vm_ = std::make_unique<SurfaceVm>(mount, L);
+      break;
+  }
+  // eq. 3.28 in the controller's unit u: N/u for position, N u/rad for
+  // orientation
+  const Gains& g = params_.gains;
+  kp_ << Eigen::Vector3d::Constant(g.k_pos_N_per_mm * u),
+      Eigen::Vector3d::Constant(g.k_ornt_Nmm_per_rad / u);
+  kv_ << Eigen::Vector3d::Constant(g.k_vel_Ns_per_mm * u),
+      Eigen::Vector3d::Constant(g.k_vel_ornt_Nmms_per_rad / u);
+  if (params_.velocity_cutoff_Hz > 0.0) {
+    const double tau = 1.0 / (2.0 * kPi * params_.velocity_cutoff_Hz);
+    velocity_alpha_ = params_.servo_period_s / (params_.servo_period_s + tau);
+  }
+  J_.resize(6, vm_->dof());
+  J_active_.resize(6, vm_->dof());
+  reset();
+}
+
+void Controller::reset() noexcept {
+  theta_v_ = vm_->zero_angles();
+  theta_r_ = vm_->zero_angles();
+  seed_ = vm_->zero_angles();
+  if (vm_->kind() == VmKind::kSurface) {
+    // probe upright; the first tick slides the contact under the stylus
+    theta_v_[2] = theta_v_[3] = 0.5 * kPi;
+    theta_r_ = theta_v_;
+  }
+  placed_ = false;
+  have_previous_ = false;
+  e_previous_.setZero();
+  e_dot_filtered_.setZero();
+}
+
+ControlStatus Controller::place(const RmPose& rm, JointMask locked,
+                                ControlOutput* out) noexcept {
+  ControlStatus st = kStatusOk;
+  const bool surface_sliding =
+      vm_->kind() == VmKind::kSurface && (locked & 3u) == 0;
+  // the closed form: nearest point (circle, sphere, sticking surface); for
+  // a sliding surface the probe aligned with the stylus, tip on the plane
+  seed_ = theta_v_;
+  const bool seed_ok = surface_sliding ? vm_->aligned(rm, &seed_)
+                                       : vm_->nearest(rm, &seed_);
+  if (!seed_ok) st |= kStatusRmAtPivot;
+  if (!placed_ && seed_ok) theta_v_ = seed_;
+  if (params_.placement == PlacementMethod::kClosedForm) {
+    if (seed_ok) theta_v_ = seed_;
+    out->placement_iterations = 0;
+    const Vec6 r = placement_residual(*vm_, rm, theta_v_);
+    out->placement_cost =
+        r.dot(params_.placement_options.weights.cwiseProduct(r));
+    return st;
+  }
+  PlacementResult res = place_gauss_newton(
+      *vm_, rm, params_.placement_options, locked, &theta_v_);
+  if (seed_ok) {
+    // a warm start can sit on the wrong stationary point (the far side of a
+    // circle after a fast move); restart from the closed form if it is better
+    const Vec6 r = placement_residual(*vm_, rm, seed_);
+    const double seed_cost =
+        r.dot(params_.placement_options.weights.cwiseProduct(r));
+    if (seed_cost < res.cost * (1.0 - 1e-9) - 1e-12) {
+      const int before = res.iterations;
+      res = place_gauss_newton(*vm_, rm, params_.placement_options, locked,
+                               &seed_);
+      res.iterations += before;
+      theta_v_ = seed_;
+    }
+  }
+  if (!res.converged) st |= kStatusPlacementNotConverged;
+  out->placement_iterations = res.iterations;
+  out->placement_cost = res.cost;
+  return st;
+}
+
+ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
+                                   ControlOutput* out) noexcept {
+  ControlStatus st = place(rm, locked, out);
+  const double u = params_.length_unit_mm;
+  const VmPose vm_pose = vm_->pose(theta_v_);
+  out->x_v_mm = vm_pose.p * u;
+  out->x_r_mm = vm_->pose(theta_r_).p * u;
+  // eq. 3.9: e = X_V - X_R
+  out->e.head<3>() = vm_pose.p - rm.p;
+  if (params_.error == ErrorFormulation::kThesis) {
+    out->e.tail<3>() = vm_->thesis_orientation_error(theta_v_, theta_r_);
+  } else {
+    bool ambiguous = false;
+    out->e.tail<3>() =
+        vm_->geometric_orientation_error(vm_pose, rm, &ambiguous);
+    if (ambiguous) st |= kStatusOrientationDegenerate;
+  }
+  // e_dot by backward difference (angle rows wrapped), low-pass filtered
+  if (have_previous_) {
+    Vec6 d = out->e - e_previous_;
+    for (int i = 3; i < 6; ++i) d[i] = wrap_angle(d[i]);
+    const Vec6 raw = d / params_.servo_period_s;
+    out->e_dot = e_dot_filtered_ + velocity_alpha_ * (raw - e_dot_filtered_);
+  } else {
+    out->e_dot.setZero();
+  }
+  // eq. 3.8 with eq. 3.28's diagonal gains, then eq. 3.11
+  const Vec6 g = kp_.cwiseProduct(out->e) + kv_.cwiseProduct(out->e_dot);
+  vm_->jacobian(theta_v_, &J_);
+  active_columns(J_, locked, &J_active_);
+  const ProjectionResult pr = project_motion_force(
+      J_active_, params_.projection_weights, g, params_.singular_rcond,
+      params_.singular_damping, &out->f_motion);
+  out->vm_rcond = pr.rcond;
+  if (pr.singular) st |= kStatusVmSingular;
+  return st;
+}
+
+ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept {
+  out->status = kStatusOk;
+  out->force_device_N.setZero();
+  out->force_base_N.setZero();
+  out->tau_dh_Nm.setZero();
+  out->tau_motor_Nm.setZero();
+  if (!q_dh.allFinite()) {
+    // a sensor fault: zero force, keep the warm start, restart e_dot
+    out->status = kStatusInvalidInput;
+    out->f_motion.setZero();
+    out->e.setZero();
+    out->e_dot.setZero();
+    have_previous_ = false;
+    return out->status;
+  }
+  ControlStatus st = kStatusOk;
+  const OmniParams& omni = params_.omni;
+  if (!omni_within_limits(omni, q_dh)) st |= kStatusOutsideJointLimits;
+
+  // 1. the RM: wrist centre and stylus axis in the device frame
+  const OmniPose pose = omni_fk(omni, q_dh);
+  out->p_rm_mm = base_to_device_mm(omni, pose.p_base_m);
+  out->axis_rm = base_to_device_vector(pose.R_base.col(2));
+  RmPose rm;
+  rm.p = out->p_rm_mm / params_.length_unit_mm;
+  rm.axis = out->axis_rm;
+
+  // 2. theta_R: the VM aligned with the stylus (kept where undefined)
+  if (!vm_->aligned(rm, &theta_r_)) st |= kStatusOrientationDegenerate;
+
+  // 3-4. placement, error and projected force. The surface with friction
+  // first tries its contact point held (prismatic joints locked) and slides
+  // only if the contact force leaves the friction cone.
+  const bool surface = vm_->kind() == VmKind::kSurface;
+  const double mu = params_.vm.friction_mu;
+  JointMask locked = (surface && mu > 0.0) ? 3u : 0u;
+  const VmAngles held = theta_v_;
+  ControlStatus st_eval = evaluate(rm, locked, out);
+  if (surface) {
+    const Vec3 n = static_cast<const SurfaceVm&>(*vm_).normal();
+    const Vec3 f = out->f_motion.head<3>();
+    const double f_n = f.dot(n);
+    const double f_t = (f - f_n * n).norm();
+    if (params_.vm.unilateral && f_n < 0.0) {
+      // the plane can only push: the probe lifts off and follows the stylus
+      st |= kStatusContactOpen;
+      vm_->aligned(rm, &theta_v_);
+      out->f_motion.setZero();
+    } else if (locked != 0 && f_t > mu * std::abs(f_n)) {
+      theta_v_ = held;
+      st_eval = evaluate(rm, 0u, out) | kStatusContactSliding;
+    }
+  }
+  st |= st_eval;
+  placed_ = true;
+  e_previous_ = out->e;
+  e_dot_filtered_ = out->e_dot;
+  have_previous_ = true;
+  out->theta_v = theta_v_;
+  out->theta_r = theta_r_;
+
+  // 5. the device force and joint torques
+  if (!out->f_motion.allFinite() || !out->e.allFinite()) {
+    out->status = st | kStatusNumericalFault;
+    out->f_motion.setZero();
+    reset();
+    return out->status;
+  }
+  Vec3 F = out->f_motion.head<3>();
+  const double F_norm = F.norm();
+  if (F_norm > params_.force_limit_N) {
+    F *= params_.force_limit_N / F_norm;
+    st |= kStatusForceSaturated;
+  }
+  // eq. 3.12 with the wrist-centre Jacobian's linear rows (m/rad) and the
+  // force in the base frame: tau in N m
+  Vec3 F_base = device_to_base_vector(F);
+  const Mat6 Jr = omni_jacobian(omni, q_dh);
+  Vec3 tau = Jr.topLeftCorner<3, 3>().transpose() * F_base;
+  // motors: t1 = -q1, t2 = q2, t3 = q2 + q3 (the third motor drives the
+  // absolute forearm angle); equal power gives these torques
+  Vec3 tau_motor(-tau[0], tau[1] - tau[2], tau[2]);
+  double scale = 1.0;
+  for (int i = 0; i < kOmniActuated; ++i) {
+    const double lim = omni.motor_torque_limit_Nm[static_cast<std::size_t>(i)];
+    if (std::abs(tau_motor[i]) * scale > lim) {
+      scale = lim / std::abs(tau_motor[i]);
+    }
+  }
+  if (scale < 1.0) {
+    F *= scale;
+    F_base *= scale;
+    tau *= scale;
+    tau_motor *= scale;
+    st |= kStatusTorqueSaturated;
+  }
+  out->force_device_N = F;
+  out->force_base_N = F_base;
+  out->tau_dh_Nm = tau;
+  out->tau_motor_Nm = tau_motor;
+  out->status = st;
+  return st;
+}
+
+}  // namespace vmh

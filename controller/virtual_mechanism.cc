@@ -1,0 +1,358 @@
+#include "controller/virtual_mechanism.h"
+
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "controller/omni_kinematics.h"  // wrap_angle
+
+namespace vmh {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// below this fraction of L a direction is treated as undefined
+constexpr double kDegenerateFraction = 1e-9;
+// |sin| below which an axis is treated as lying on a pole
+constexpr double kPoleSin = 1e-12;
+
+double clamp_unit(double x) { return x < -1.0 ? -1.0 : (x > 1.0 ? 1.0 : x); }
+
+void check_mount(const VmMount& mount, double length) {
+  if (!mount.origin.allFinite()) {
+    throw std::invalid_argument("virtual mechanism: pivot is not finite");
+  }
+  if (!mount.R.allFinite() ||
+      !(mount.R.transpose() * mount.R).isIdentity(1e-9) ||
+      std::abs(mount.R.determinant() - 1.0) > 1e-9) {
+    throw std::invalid_argument(
+        "virtual mechanism: pivot orientation is not a rotation matrix");
+  }
+  if (!std::isfinite(length) || length <= 0.0) {
+    throw std::invalid_argument(
+        "virtual mechanism: length must be finite and > 0, got " +
+        std::to_string(length));
+  }
+}
+
+// any unit vector perpendicular to u
+Vec3 perpendicular(const Vec3& u) {
+  const Vec3 other = std::abs(u.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  return u.cross(other).normalized();
+}
+
+// rotation about the local z axis
+Mat3 rot_z(double a) {
+  Mat3 R;
+  const double c = std::cos(a), s = std::sin(a);
+  R << c, -s, 0, s, c, 0, 0, 0, 1;
+  return R;
+}
+
+}  // namespace
+
+const char* vm_kind_name(VmKind kind) {
+  switch (kind) {
+    case VmKind::kCircle:
+      return "circle";
+    case VmKind::kSphere:
+      return "sphere";
+    case VmKind::kSurface:
+      return "surface";
+  }
+  return "unknown";
+}
+
+bool parse_vm_kind(const char* text, VmKind* kind) {
+  for (VmKind k : {VmKind::kCircle, VmKind::kSphere, VmKind::kSurface}) {
+    if (std::strcmp(text, vm_kind_name(k)) == 0) {
+      *kind = k;
+      return true;
+    }
+  }
+  return false;
+}
+
+// ---------------------------------------------------------------- base class
+
+VirtualMechanism::VirtualMechanism(const VmMount& mount, double length)
+    : mount_(mount), length_(length) {
+  check_mount(mount, length);
+}
+
+VmAngles VirtualMechanism::zero_angles() const {
+  return VmAngles::Zero(dof());
+}
+
+Vec3 VirtualMechanism::geometric_orientation_error(const VmPose& vm,
+                                                   const RmPose& rm,
+                                                   bool* ambiguous) const {
+  // smallest rotation carrying the stylus axis a onto the link axis u:
+  // axis a x u, angle atan2(|a x u|, a.u), so e = angle * (a x u)/|a x u|
+  const Vec3 a = rm.axis.normalized();
+  const Vec3 k = a.cross(vm.axis);
+  const double s = k.norm();
+  const double c = a.dot(vm.axis);
+  if (ambiguous != nullptr) *ambiguous = false;
+  if (s < kPoleSin) {
+    if (c > 0.0) return Vec3::Zero();
+    // opposite: every axis perpendicular to u turns a onto u by pi
+    if (ambiguous != nullptr) *ambiguous = true;
+    return kPi * perpendicular(vm.axis);
+  }
+  return std::atan2(s, c) / s * k;
+}
+
+// -------------------------------------------------------------------- circle
+
+CircleVm::CircleVm(const VmMount& mount, double length)
+    : VirtualMechanism(mount, length) {}
+
+VmPose CircleVm::pose(const VmAngles& theta) const {
+  // eq. 3.25/3.26 in the pivot frame, then into the device frame
+  const double c = std::cos(theta[0]), s = std::sin(theta[0]);
+  VmPose out;
+  out.axis = mount_.R * Vec3(c, s, 0.0);
+  out.p = mount_.origin + length_ * out.axis;
+  out.R = mount_.R * rot_z(theta[0]);
+  return out;
+}
+
+void CircleVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
+  // eq. 3.27: (-L sin, L cos, 0, 0, 0, 1) in the pivot frame
+  const double c = std::cos(theta[0]), s = std::sin(theta[0]);
+  J->resize(6, 1);
+  J->block<3, 1>(0, 0) = mount_.R * Vec3(-length_ * s, length_ * c, 0.0);
+  J->block<3, 1>(3, 0) = mount_.R.col(2);
+}
+
+bool CircleVm::nearest(const RmPose& rm, VmAngles* theta) const {
+  // §3.3.1: theta_V = atan2(Y - Y0, X - X0), in the pivot frame
+  const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
+  if (!(std::hypot(d.x(), d.y()) > kDegenerateFraction * length_)) {
+    return false;
+  }
+  (*theta)[0] = std::atan2(d.y(), d.x());
+  return true;
+}
+
+bool CircleVm::aligned(const RmPose& rm, VmAngles* theta) const {
+  // §3.3.1: theta_R = atan2(Z_y, Z_x) of the stylus z axis
+  const Vec3 a = mount_.R.transpose() * rm.axis;
+  if (!(std::hypot(a.x(), a.y()) > kPoleSin)) return false;
+  (*theta)[0] = std::atan2(a.y(), a.x());
+  return true;
+}
+
+Vec3 CircleVm::thesis_orientation_error(const VmAngles& theta_v,
+                                        const VmAngles& theta_r) const {
+  return mount_.R.col(2) * wrap_angle(theta_v[0] - theta_r[0]);
+}
+
+Vec3 CircleVm::geometric_orientation_error(const VmPose& vm, const RmPose& rm,
+                                           bool* ambiguous) const {
+  // the planar rotation from the stylus axis's projection onto the plane to
+  // the link; about the plane normal, so J_V's one angular row absorbs it
+  const Vec3 n = mount_.R.col(2);
+  const Vec3 a = rm.axis - rm.axis.dot(n) * n;
+  if (ambiguous != nullptr) *ambiguous = false;
+  if (!(a.norm() > kPoleSin)) {
+    if (ambiguous != nullptr) *ambiguous = true;
+    return Vec3::Zero();
+  }
+  return n * std::atan2(n.dot(a.cross(vm.axis)), a.dot(vm.axis));
+}
+
+void CircleVm::normalize(VmAngles* theta) const {
+  (*theta)[0] = wrap_angle((*theta)[0]);
+}
+
+// -------------------------------------------------------------------- sphere
+
+SphereVm::SphereVm(const VmMount& mount, double length)
+    : VirtualMechanism(mount, length) {}
+
+VmPose SphereVm::pose(const VmAngles& theta) const {
+  // eq. 3.29/3.30 in the pivot frame
+  const double s1 = std::sin(theta[0]), c1 = std::cos(theta[0]);
+  const double s2 = std::sin(theta[1]), c2 = std::cos(theta[1]);
+  const double s3 = std::sin(theta[2]), c3 = std::cos(theta[2]);
+  Mat3 R;
+  R << s1 * s3 + c1 * c2 * c3, s1 * c3 - c1 * c2 * s3, c1 * s2,  //
+      s1 * c2 * c3 - c1 * s3, -c1 * c3 - s1 * c2 * s3, s1 * s2,  //
+      s2 * c3, -s2 * s3, -c2;
+  VmPose out;
+  out.R = mount_.R * R;
+  out.axis = out.R.col(2);
+  out.p = mount_.origin + length_ * out.axis;
+  return out;
+}
+
+void SphereVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
+  // eq. 3.31 in the pivot frame
+  const double s1 = std::sin(theta[0]), c1 = std::cos(theta[0]);
+  const double s2 = std::sin(theta[1]), c2 = std::cos(theta[1]);
+  const double L = length_;
+  Eigen::Matrix<double, 6, 3> Jl;
+  Jl << -L * s1 * s2, L * c1 * c2, 0,  //
+      L * c1 * s2, L * s1 * c2, 0,     //
+      0, L * s2, 0,                    //
+      0, s1, c1 * s2,                  //
+      0, -c1, s1 * s2,                 //
+      1, 0, -c2;
+  J->resize(6, 3);
+  J->topRows<3>() = mount_.R * Jl.topRows<3>();
+  J->bottomRows<3>() = mount_.R * Jl.bottomRows<3>();
+}
+
+namespace {
+// polar angle from -z and azimuth of a unit direction d (pivot frame):
+// theta2 = pi - acos(d_z) = acos(-d_z) (§3.4.1), theta1 = atan2(d_y, d_x);
+// on the pole axis theta1 is left as it was
+void sphere_angles(const Vec3& d, VmAngles* theta) {
+  (*theta)[1] = std::acos(clamp_unit(-d.z()));
+  if (std::hypot(d.x(), d.y()) > kPoleSin) {
+    (*theta)[0] = std::atan2(d.y(), d.x());
+  }
+}
+}  // namespace
+
+bool SphereVm::nearest(const RmPose& rm, VmAngles* theta) const {
+  const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
+  const double LL = d.norm();  // §3.4.1's LL
+  if (!(LL > kDegenerateFraction * length_)) return false;
+  sphere_angles(d / LL, theta);
+  return true;
+}
+
+bool SphereVm::aligned(const RmPose& rm, VmAngles* theta) const {
+  const Vec3 a = mount_.R.transpose() * rm.axis;
+  const double n = a.norm();
+  if (!(n > kPoleSin)) return false;
+  sphere_angles(a / n, theta);
+  return true;
+}
+
+Vec3 SphereVm::thesis_orientation_error(const VmAngles& theta_v,
+                                        const VmAngles& theta_r) const {
+  // eq. 3.35-3.37: (theta_V3 - theta_R3 = 0, theta_V2 - theta_R2,
+  // theta_V1 - theta_R1) as the (theta_x, theta_y, theta_z) rows
+  return mount_.R * Vec3(0.0, wrap_angle(theta_v[1] - theta_r[1]),
+                         wrap_angle(theta_v[0] - theta_r[0]));
+}
+
+void SphereVm::normalize(VmAngles* theta) const {
+  double t2 = wrap_angle((*theta)[1]);
+  if (t2 < 0.0) {
+    // (t1 + pi, -t2, t3 + pi) is the same handle pose
+    t2 = -t2;
+    (*theta)[0] += kPi;
+    (*theta)[2] += kPi;
+  }
+  (*theta)[0] = wrap_angle((*theta)[0]);
+  (*theta)[1] = t2;
+  (*theta)[2] = wrap_angle((*theta)[2]);
+}
+
+// ------------------------------------------------------------------- surface
+
+SurfaceVm::SurfaceVm(const VmMount& mount, double length)
+    : VirtualMechanism(mount, length) {}
+
+Vec3 SurfaceVm::contact(const VmAngles& theta) const {
+  return mount_.origin + theta[0] * mount_.R.col(0) +
+         theta[1] * mount_.R.col(1);
+}
+
+VmPose SurfaceVm::pose(const VmAngles& theta) const {
+  // frame = Rx(alpha) Rz(beta) C Rz(gamma) in the plane frame, with C the
+  // constant rotation taking (x, y, z) to (y, z, x); its z column is
+  // u = (cos b, sin b cos a, sin b sin a)
+  const double sa = std::sin(theta[2]), ca = std::cos(theta[2]);
+  const double sb = std::sin(theta[3]), cb = std::cos(theta[3]);
+  Mat3 F;
+  F.col(0) = Vec3(-sb, cb * ca, cb * sa);  // du/dbeta
+  F.col(2) = Vec3(cb, sb * ca, sb * sa);   // u
+  F.col(1) = F.col(2).cross(F.col(0));
+  VmPose out;
+  out.R = mount_.R * F * rot_z(theta[4]);
+  out.axis = mount_.R * F.col(2);
+  out.p = contact(theta) + length_ * out.axis;
+  return out;
+}
+
+void SurfaceVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
+  const double sa = std::sin(theta[2]), ca = std::cos(theta[2]);
+  const double sb = std::sin(theta[3]), cb = std::cos(theta[3]);
+  const Vec3 t1 = mount_.R.col(0);
+  const Vec3 u = mount_.R * Vec3(cb, sb * ca, sb * sa);
+  const Vec3 w_beta = mount_.R * Vec3(0.0, -sa, ca);
+  J->resize(6, 5);
+  J->setZero();
+  J->block<3, 1>(0, 0) = t1;                         // s1
+  J->block<3, 1>(0, 1) = mount_.R.col(1);            // s2
+  J->block<3, 1>(0, 2) = length_ * t1.cross(u);      // alpha, about t1
+  J->block<3, 1>(3, 2) = t1;                         //
+  J->block<3, 1>(0, 3) = length_ * w_beta.cross(u);  // beta
+  J->block<3, 1>(3, 3) = w_beta;                     //
+  J->block<3, 1>(3, 4) = u;                          // gamma, twist
+}
+
+namespace {
+// alpha, beta of a unit direction d in the plane frame; alpha kept on the
+// poles d = +-t1
+void surface_angles(const Vec3& d, VmAngles* theta) {
+  (*theta)[3] = std::acos(clamp_unit(d.x()));
+  if (std::hypot(d.y(), d.z()) > kPoleSin) {
+    (*theta)[2] = std::atan2(d.z(), d.y());
+  }
+}
+}  // namespace
+
+bool SurfaceVm::nearest(const RmPose& rm, VmAngles* theta) const {
+  const Vec3 d = mount_.R.transpose() * (rm.p - contact(*theta));
+  const double n = d.norm();
+  if (!(n > kDegenerateFraction * length_)) return false;
+  surface_angles(d / n, theta);
+  return true;
+}
+
+bool SurfaceVm::aligned(const RmPose& rm, VmAngles* theta) const {
+  const double n = rm.axis.norm();
+  if (!(n > kPoleSin)) return false;
+  const Vec3 a = rm.axis / n;
+  surface_angles(mount_.R.transpose() * a, theta);
+  const Vec3 tip = rm.p - length_ * a - mount_.origin;
+  (*theta)[0] = mount_.R.col(0).dot(tip);
+  (*theta)[1] = mount_.R.col(1).dot(tip);
+  return true;
+}
+
+Vec3 SurfaceVm::thesis_orientation_error(const VmAngles& theta_v,
+                                         const VmAngles& theta_r) const {
+  // no thesis formula: the wrapped revolute differences, each along its own
+  // joint axis at theta_V (first order in the differences)
+  VmJacobian J;
+  jacobian(theta_v, &J);
+  Vec3 e = Vec3::Zero();
+  for (int j = 2; j < 5; ++j) {
+    e += J.block<3, 1>(3, j) * wrap_angle(theta_v[j] - theta_r[j]);
+  }
+  return e;
+}
+
+void SurfaceVm::normalize(VmAngles* theta) const {
+  double b = wrap_angle((*theta)[3]);
+  if (b < 0.0) {
+    // (alpha + pi, -beta, gamma + pi) is the same handle pose
+    b = -b;
+    (*theta)[2] += kPi;
+    (*theta)[4] += kPi;
+  }
+  (*theta)[2] = wrap_angle((*theta)[2]);
+  (*theta)[3] = b;
+  (*theta)[4] = wrap_angle((*theta)[4]);
+}
+
+}  // namespace vmh

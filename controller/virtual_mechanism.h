@@ -1,0 +1,201 @@
+// Virtual mechanisms (VMs): the imaginary constrained manipulators of
+// Beckman & Luecke whose motion the real Omni is made to feel (thesis §3.1).
+//
+// A VM has m joint coordinates theta (m <= 5), a handle pose X_V(theta) and a
+// 6 x m Jacobian J_V whose rows are the handle's linear velocity (rows 0-2)
+// and angular velocity (rows 3-5), both in the device frame. Three VMs are
+// provided:
+//   CircleVm  - 1 DOF: a link of length L turning about a pivot in a plane
+//               (eq. 3.25-3.27). Appendix D puts the plane in the device x-y
+//               plane; here the plane is the pivot frame's x-y plane.
+//   SphereVm  - 3 DOF: a link of length L on a ball joint at the pivot
+//               (eq. 3.29-3.31); theta = (azimuth, polar, twist).
+//   SurfaceVm - 5 DOF: a probe whose tip slides on a plane (two prismatic
+//               joints) with a ball joint at the tip (three revolute joints),
+//               thesis §3.1. theta = (s1, s2, alpha, beta, gamma).
+//
+// Units: the mechanisms do not know about units. Every length (pivot, L,
+// positions, prismatic coordinates) is in one length unit chosen by the
+// caller; the Controller uses its `length_unit_mm` (mm by default, as in the
+// thesis). Angles are in rad.
+//
+// Orientation: the quantity a VM compares with the Omni is the direction of
+// its link, `axis` (pivot or tip -> handle), against the stylus axis (the z
+// column of the OpenHaptics stylus transform, pointing from the pen tip back
+// toward the gimbal). Twist about the axis is free in every VM.
+//
+// Nothing here allocates or throws after construction; constructors throw
+// std::invalid_argument naming a bad parameter.
+#ifndef VMHAPTICS_CONTROLLER_VIRTUAL_MECHANISM_H_
+#define VMHAPTICS_CONTROLLER_VIRTUAL_MECHANISM_H_
+
+#include <limits>
+
+#include "controller/types.h"
+
+namespace vmh {
+
+inline constexpr int kMaxVmDof = 5;
+
+// fixed-capacity, run-time-sized: stored inline, so no heap allocation
+using VmAngles =
+    Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxVmDof, 1>;
+using VmJacobian =
+    Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::ColMajor, 6, kMaxVmDof>;
+
+enum class VmKind { kCircle, kSphere, kSurface };
+
+// "circle", "sphere", "surface"
+const char* vm_kind_name(VmKind kind);
+// parses the names above; false for anything else
+bool parse_vm_kind(const char* text, VmKind* kind);
+
+// What a VM sees of the real manipulator (RM): the wrist-centre position and
+// the unit stylus axis, both in the device frame (position in the caller's
+// length unit).
+struct RmPose {
+  Vec3 p = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ();
+};
+
+// The handle pose X_V(theta): position, handle frame (the thesis's 0_2T or
+// 0_4T rotation), and link axis, all in the device frame.
+struct VmPose {
+  Vec3 p = Vec3::Zero();
+  Mat3 R = Mat3::Identity();
+  Vec3 axis = Vec3::UnitX();
+};
+
+// Where a VM is attached: its pivot (circle, sphere) or a point of its plane
+// (surface), and the pivot frame's orientation in the device frame. The
+// circle lies in the pivot frame's x-y plane; the sphere's polar angle is
+// measured from the pivot frame's -z axis (eq. 3.30); the surface's normal is
+// the pivot frame's z axis.
+struct VmMount {
+  Vec3 origin = Vec3::Zero();
+  Mat3 R = Mat3::Identity();
+};
+
+class VirtualMechanism {
+ public:
+  VirtualMechanism(const VmMount& mount, double length);
+  virtual ~VirtualMechanism() = default;
+
+  virtual VmKind kind() const = 0;
+  virtual int dof() const = 0;
+
+  // X_V(theta): handle pose in the device frame
+  virtual VmPose pose(const VmAngles& theta) const = 0;
+  // J_V(theta), 6 x dof(): rows 0-2 linear velocity of the handle (length
+  // unit per rad, or per length unit for a prismatic joint), rows 3-5 angular
+  // velocity (rad per rad); device frame
+  virtual void jacobian(const VmAngles& theta, VmJacobian* J) const = 0;
+
+  // Closed-form placements (§3.2). `nearest` puts the handle at the point of
+  // the VM's path closest to the RM's position (weight W_p, eq. 3.21-3.24,
+  // the thesis's theta_V); `aligned` turns the link onto the stylus axis
+  // (weight W_o, eq. 3.17-3.20, the thesis's theta_R). Each returns false
+  // and leaves *theta untouched where the answer is undefined (the RM at the
+  // pivot, or the axis along the circle's normal / the sphere's pole axis);
+  // otherwise angles the closed form does not fix (twist, and for the
+  // surface the contact point) keep their values from *theta.
+  virtual bool nearest(const RmPose& rm, VmAngles* theta) const = 0;
+  virtual bool aligned(const RmPose& rm, VmAngles* theta) const = 0;
+
+  // The thesis's orientation error rows (theta_x, theta_y, theta_z) from
+  // joint-angle differences, each wrapped to (-pi, pi] (eq. 3.32-3.37 and
+  // §3.3.1). The surface has no thesis formula; it maps the wrapped revolute
+  // differences through its rotational Jacobian rows (docs/control.md).
+  virtual Vec3 thesis_orientation_error(const VmAngles& theta_v,
+                                        const VmAngles& theta_r) const = 0;
+
+  // The rotation vector (device frame) of the smallest rotation that carries
+  // the stylus axis onto the VM's link axis; consistent with the angular
+  // velocity rows of J_V. Planar VMs first project the stylus axis into
+  // their plane. *ambiguous (optional) is set when the two are opposite or
+  // the projection vanishes, where the direction is a choice.
+  virtual Vec3 geometric_orientation_error(const VmPose& vm, const RmPose& rm,
+                                           bool* ambiguous) const;
+
+  // true for angular joints (wrapped, unbounded or periodic), false for
+  // prismatic ones
+  virtual bool is_revolute(int joint) const = 0;
+  // brings theta to its canonical range (angles wrapped to (-pi, pi], the
+  // polar angle to [0, pi]) without moving the handle
+  virtual void normalize(VmAngles* theta) const = 0;
+
+  // a VmAngles of size dof(), zero
+  VmAngles zero_angles() const;
+
+  const VmMount& mount() const { return mount_; }
+  double length() const { return length_; }
+
+ protected:
+  VmMount mount_;
+  double length_;
+};
+
+class CircleVm final : public VirtualMechanism {
+ public:
+  CircleVm(const VmMount& mount, double length);
+  VmKind kind() const override { return VmKind::kCircle; }
+  int dof() const override { return 1; }
+  VmPose pose(const VmAngles& theta) const override;
+  void jacobian(const VmAngles& theta, VmJacobian* J) const override;
+  bool nearest(const RmPose& rm, VmAngles* theta) const override;
+  bool aligned(const RmPose& rm, VmAngles* theta) const override;
+  Vec3 thesis_orientation_error(const VmAngles& theta_v,
+                                const VmAngles& theta_r) const override;
+  Vec3 geometric_orientation_error(const VmPose& vm, const RmPose& rm,
+                                   bool* ambiguous) const override;
+  bool is_revolute(int) const override { return true; }
+  void normalize(VmAngles* theta) const override;
+};
+
+class SphereVm final : public VirtualMechanism {
+ public:
+  SphereVm(const VmMount& mount, double length);
+  VmKind kind() const override { return VmKind::kSphere; }
+  int dof() const override { return 3; }
+  VmPose pose(const VmAngles& theta) const override;
+  void jacobian(const VmAngles& theta, VmJacobian* J) const override;
+  bool nearest(const RmPose& rm, VmAngles* theta) const override;
+  bool aligned(const RmPose& rm, VmAngles* theta) const override;
+  Vec3 thesis_orientation_error(const VmAngles& theta_v,
+                                const VmAngles& theta_r) const override;
+  bool is_revolute(int) const override { return true; }
+  void normalize(VmAngles* theta) const override;
+};
+
+// The plane passes through mount.origin with normal mount.R.col(2); the
+// prismatic joints slide along mount.R.col(0) and col(1). The link direction
+// is u = cos(beta) t1 + sin(beta) (cos(alpha) t2 + sin(alpha) n), so the
+// probe standing upright (u = n) is at alpha = beta = pi/2, far from the
+// parametrisation's poles (u = +-t1, the probe lying in the plane).
+class SurfaceVm final : public VirtualMechanism {
+ public:
+  SurfaceVm(const VmMount& mount, double length);
+  VmKind kind() const override { return VmKind::kSurface; }
+  int dof() const override { return 5; }
+  VmPose pose(const VmAngles& theta) const override;
+  void jacobian(const VmAngles& theta, VmJacobian* J) const override;
+  // nearest: keeps the contact point and turns the probe toward the RM
+  // (the sticking probe); aligned: turns the probe onto the stylus axis and
+  // slides the contact under the stylus tip, p - L * axis projected on the
+  // plane
+  bool nearest(const RmPose& rm, VmAngles* theta) const override;
+  bool aligned(const RmPose& rm, VmAngles* theta) const override;
+  Vec3 thesis_orientation_error(const VmAngles& theta_v,
+                                const VmAngles& theta_r) const override;
+  bool is_revolute(int joint) const override { return joint >= 2; }
+  void normalize(VmAngles* theta) const override;
+
+  // the contact point (device frame) for theta
+  Vec3 contact(const VmAngles& theta) const;
+  // unit normal of the plane (device frame)
+  Vec3 normal() const { return mount_.R.col(2); }
+};
+
+}  // namespace vmh
+
+#endif  // VMHAPTICS_CONTROLLER_VIRTUAL_MECHANISM_H_
