@@ -41,21 +41,32 @@ Vec6 placement_residual(const VirtualMechanism& vm, const RmPose& rm,
   return r;
 }
 
+namespace {
+double weighted_cost(const Vec6& r, const Vec6& w) {
+  return r.dot(w.cwiseProduct(r));
+}
+}  // namespace
+
 PlacementResult place_gauss_newton(const VirtualMechanism& vm,
                                    const RmPose& rm,
                                    const PlacementOptions& options,
                                    JointMask locked, VmAngles* theta) {
   PlacementResult result;
-  const auto W = options.weights.asDiagonal();
+  const Vec6& w = options.weights;
+  const auto W = w.asDiagonal();
   VmJacobian J, Ja;
   SmallSquare A;
-  VmAngles step, full_step;
+  VmAngles step, full_step, trial;
+  Vec6 r = placement_residual(vm, rm, *theta);
+  double cost = weighted_cost(r, w);
   for (int it = 0; it < options.max_iterations; ++it) {
-    const Vec6 r = placement_residual(vm, rm, *theta);
     vm.jacobian(*theta, &J);
     active_columns(J, locked, &Ja);
     const int m = static_cast<int>(Ja.cols());
-    if (m == 0) break;
+    if (m == 0) {
+      result.converged = true;
+      break;
+    }
     A.noalias() = Ja.transpose() * W * Ja;
     const double mean_diag = A.diagonal().sum() / m;
     const double lambda = options.relative_damping * mean_diag + 1e-300;
@@ -69,15 +80,39 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
     for (int j = 0, k = 0; j < vm.dof(); ++j) {
       if ((locked & (JointMask{1} << j)) == 0) full_step[j] = step[k++];
     }
-    *theta += full_step;
-    vm.normalize(theta);
     if (step.cwiseAbs().maxCoeff() < options.tolerance) {
+      *theta += full_step;
+      vm.normalize(theta);
+      r = placement_residual(vm, rm, *theta);
+      cost = weighted_cost(r, w);
+      result.converged = true;
+      break;
+    }
+    // Far from the path the Gauss-Newton step overshoots (its rate on a
+    // circle is |1 - d/L| for a point at distance d from the pivot, so it
+    // diverges beyond d = 2L): halve it until the cost goes down.
+    bool descended = false;
+    for (int halving = 0; halving < 30; ++halving) {
+      trial = *theta + full_step;
+      vm.normalize(&trial);
+      const Vec6 r_trial = placement_residual(vm, rm, trial);
+      const double cost_trial = weighted_cost(r_trial, w);
+      if (cost_trial <= cost) {
+        *theta = trial;
+        r = r_trial;
+        cost = cost_trial;
+        descended = true;
+        break;
+      }
+      full_step *= 0.5;
+    }
+    if (!descended) {
+      // no step lowers the cost: a minimum to working precision
       result.converged = true;
       break;
     }
   }
-  const Vec6 r = placement_residual(vm, rm, *theta);
-  result.cost = r.dot(options.weights.cwiseProduct(r));
+  result.cost = cost;
   return result;
 }
 

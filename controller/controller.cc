@@ -214,22 +214,20 @@ ControlStatus Controller::place(const RmPose& rm, JointMask locked,
         r.dot(params_.placement_options.weights.cwiseProduct(r));
     return st;
   }
-  PlacementResult res = place_gauss_newton(
-      *vm_, rm, params_.placement_options, locked, &theta_v_);
   if (seed_ok) {
-    // a warm start can sit on the wrong stationary point (the far side of a
-    // circle after a fast move); restart from the closed form if it is better
-    const Vec6 r = placement_residual(*vm_, rm, seed_);
-    const double seed_cost =
-        r.dot(params_.placement_options.weights.cwiseProduct(r));
-    if (seed_cost < res.cost * (1.0 - 1e-9) - 1e-12) {
-      const int before = res.iterations;
-      res = place_gauss_newton(*vm_, rm, params_.placement_options, locked,
-                               &seed_);
-      res.iterations += before;
+    // start from the better of the warm start and the closed form: a warm
+    // start can sit on the wrong side of a circle after a fast move, and
+    // for W_p the closed form is already the answer
+    const Vec6& w = params_.placement_options.weights;
+    const Vec6 r_warm = placement_residual(*vm_, rm, theta_v_);
+    const Vec6 r_seed = placement_residual(*vm_, rm, seed_);
+    if (r_seed.dot(w.cwiseProduct(r_seed)) <
+        r_warm.dot(w.cwiseProduct(r_warm))) {
       theta_v_ = seed_;
     }
   }
+  const PlacementResult res = place_gauss_newton(
+      *vm_, rm, params_.placement_options, locked, &theta_v_);
   if (!res.converged) st |= kStatusPlacementNotConverged;
   out->placement_iterations = res.iterations;
   out->placement_cost = res.cost;
@@ -310,6 +308,8 @@ ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept 
   const bool surface = vm_->kind() == VmKind::kSurface;
   const double mu = params_.vm.friction_mu;
   JointMask locked = (surface && mu > 0.0) ? 3u : 0u;
+  // first touch: the contact point under the stylus tip
+  if (surface && !placed_) vm_->aligned(rm, &theta_v_);
   const VmAngles held = theta_v_;
   ControlStatus st_eval = evaluate(rm, locked, out);
   if (surface) {

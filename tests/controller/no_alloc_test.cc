@@ -1,4 +1,5 @@
-// The kinematics used in the servo loop allocate nothing and throw nothing.
+// The servo loop allocates nothing and throws nothing: the kinematics and
+// Controller::tick for every mechanism and option.
 //
 // This binary compiles the controller sources itself with
 // EIGEN_RUNTIME_NO_MALLOC and a throwing eigen_assert (see
@@ -10,8 +11,10 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
+#include "controller/controller.h"
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "tests/support/alloc_counter.h"
@@ -123,6 +126,65 @@ TEST(NoAlloc, DeviceFrameConversions) {
             base_to_device_vector(pose.R_base.col(2)).sum();
   });
   EXPECT_TRUE(std::isfinite(sink));
+}
+
+// every mechanism, error formulation and placement method, over random
+// poses, the home pose (the RM at the pivot), the sphere's pole and
+// non-finite samples, with the saturations active
+TEST(NoAlloc, ControllerTick) {
+  static_assert(noexcept(std::declval<Controller&>().tick(
+                    std::declval<const Joints&>(),
+                    std::declval<ControlOutput*>())),
+                "tick() must be noexcept");
+  std::vector<ControllerParams> variants;
+  for (VmKind kind : {VmKind::kCircle, VmKind::kSphere, VmKind::kSurface}) {
+    for (ErrorFormulation f :
+         {ErrorFormulation::kThesis, ErrorFormulation::kGeometric}) {
+      for (PlacementMethod m :
+           {PlacementMethod::kGaussNewton, PlacementMethod::kClosedForm}) {
+        ControllerParams p;
+        p.vm.kind = kind;
+        p.error = f;
+        p.placement = m;
+        p.gains.k_ornt_Nmm_per_rad = thesis_orientation_gain(0.5, 50.0);
+        p.gains.k_vel_Ns_per_mm = 0.002;
+        if (kind == VmKind::kSurface) {
+          p.placement_options.weights = Vec6::Ones();
+          p.vm.pivot_mm = Vec3(0, 0, -50);
+          p.vm.friction_mu = 0.5;
+          p.vm.unilateral = true;
+        }
+        variants.push_back(p);
+      }
+    }
+  }
+  std::vector<Joints> qs = random_configurations(200);
+  qs.push_back(Joints::Zero());
+  Joints nan_q = Joints::Zero();
+  nan_q[2] = std::nan("");
+  qs.push_back(nan_q);
+  qs.push_back(Joints::Constant(1e300));
+  int ticks = 0;
+  for (const ControllerParams& p : variants) {
+    Controller c(p);  // construction may allocate
+    ControlOutput out;
+    std::size_t allocations = 0;
+    {
+      NoEigenMalloc guard;
+      AllocationScope scope;
+      for (const Joints& q : qs) {
+        EXPECT_NO_THROW(c.tick(q, &out));
+        ++ticks;
+      }
+      c.reset();
+      EXPECT_NO_THROW(c.tick(qs[0], &out));
+      allocations = scope.count();
+    }
+    EXPECT_EQ(allocations, 0u) << vm_kind_name(p.vm.kind) << " "
+                               << error_formulation_name(p.error) << " "
+                               << placement_method_name(p.placement);
+  }
+  EXPECT_EQ(ticks, 12 * 203);
 }
 
 }  // namespace
