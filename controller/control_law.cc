@@ -51,65 +51,80 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
                                    const RmPose& rm,
                                    const PlacementOptions& options,
                                    JointMask locked, VmAngles* theta) {
+  // Gauss-Newton with Levenberg-Marquardt damping (Nielsen's update): near
+  // a small-residual solution the damping shrinks and the steps are eq. 3.15
+  // itself; where Gauss-Newton overshoots (a point beyond 2L from a circle's
+  // pivot, where the plain iteration diverges at rate |1 - d/L|, or a
+  // surface probe stretched toward an RM it cannot reach) the damping grows
+  // and the step turns toward steepest descent.
   PlacementResult result;
   const Vec6& w = options.weights;
   const auto W = w.asDiagonal();
   VmJacobian J, Ja;
-  SmallSquare A;
-  VmAngles step, full_step, trial;
+  SmallSquare A, A_damped;
+  VmAngles grad, step, full_step, trial;
   Vec6 r = placement_residual(vm, rm, *theta);
   double cost = weighted_cost(r, w);
+  double mu = options.relative_damping;  // relative to diag(A)
+  double nu = 2.0;
+  bool fresh = true;  // J, A and grad belong to the current theta
   for (int it = 0; it < options.max_iterations; ++it) {
-    vm.jacobian(*theta, &J);
-    active_columns(J, locked, &Ja);
-    const int m = static_cast<int>(Ja.cols());
-    if (m == 0) {
-      result.converged = true;
-      break;
+    if (fresh) {
+      vm.jacobian(*theta, &J);
+      active_columns(J, locked, &Ja);
+      if (Ja.cols() == 0) {
+        result.converged = true;
+        break;
+      }
+      A.noalias() = Ja.transpose() * W * Ja;
+      grad.noalias() = Ja.transpose() * (W * r);
+      fresh = false;
     }
-    A.noalias() = Ja.transpose() * W * Ja;
-    const double mean_diag = A.diagonal().sum() / m;
-    const double lambda = options.relative_damping * mean_diag + 1e-300;
-    A.diagonal().array() += lambda;
-    step.noalias() = Ja.transpose() * (W * r);
-    A.ldlt().solveInPlace(step);
+    const int m = static_cast<int>(Ja.cols());
+    const double mean_diag = A.diagonal().sum() / m + 1e-300;
+    A_damped = A;
+    for (int i = 0; i < m; ++i) {
+      A_damped(i, i) += mu * (A(i, i) + 1e-12 * mean_diag) + 1e-300;
+    }
+    step = A_damped.ldlt().solve(grad);
     result.iterations = it + 1;
     if (!step.allFinite()) break;
-    // scatter the active step back onto the joints
     full_step = VmAngles::Zero(vm.dof());
     for (int j = 0, k = 0; j < vm.dof(); ++j) {
       if ((locked & (JointMask{1} << j)) == 0) full_step[j] = step[k++];
     }
-    if (step.cwiseAbs().maxCoeff() < options.tolerance) {
-      *theta += full_step;
-      vm.normalize(theta);
-      r = placement_residual(vm, rm, *theta);
-      cost = weighted_cost(r, w);
-      result.converged = true;
-      break;
-    }
-    // Far from the path the Gauss-Newton step overshoots (its rate on a
-    // circle is |1 - d/L| for a point at distance d from the pivot, so it
-    // diverges beyond d = 2L): halve it until the cost goes down.
-    bool descended = false;
-    for (int halving = 0; halving < 30; ++halving) {
-      trial = *theta + full_step;
-      vm.normalize(&trial);
-      const Vec6 r_trial = placement_residual(vm, rm, trial);
-      const double cost_trial = weighted_cost(r_trial, w);
-      if (cost_trial <= cost) {
-        *theta = trial;
-        r = r_trial;
-        cost = cost_trial;
-        descended = true;
+    trial = *theta + full_step;
+    vm.normalize(&trial);
+    const Vec6 r_trial = placement_residual(vm, rm, trial);
+    const double cost_trial = weighted_cost(r_trial, w);
+    // predicted decrease of r^T W r for the linearised residual
+    const double predicted = step.dot(2.0 * grad - A * step);
+    const double actual = cost - cost_trial;
+    const bool small_step = step.cwiseAbs().maxCoeff() < options.tolerance;
+    if (actual >= 0.0 && predicted > 0.0) {
+      const double rho = actual / predicted;
+      *theta = trial;
+      r = r_trial;
+      cost = cost_trial;
+      fresh = true;
+      const double t = 2.0 * rho - 1.0;
+      mu *= std::max(1.0 / 3.0, 1.0 - t * t * t);
+      mu = std::max(mu, options.relative_damping);
+      nu = 2.0;
+      // converged: the step is below tolerance, or the cost is flat to
+      // rounding (an ill-conditioned J^T W J can keep the step above it)
+      if (small_step || actual <= 1e-14 * cost_trial) {
+        result.converged = true;
         break;
       }
-      full_step *= 0.5;
-    }
-    if (!descended) {
-      // no step lowers the cost: a minimum to working precision
-      result.converged = true;
-      break;
+    } else {
+      if (small_step || !(predicted > 0.0)) {
+        // no descent left along any damped step: a minimum to precision
+        result.converged = true;
+        break;
+      }
+      mu *= nu;
+      nu *= 2.0;
     }
   }
   result.cost = cost;

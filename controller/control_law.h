@@ -28,7 +28,11 @@ struct PlacementOptions {
   // (0,0,0,1,1,1) is W_o (eq. 3.17: aligned with the stylus, theta_R).
   Vec6 weights = (Vec6() << 1, 1, 1, 0, 0, 0).finished();
   double tolerance = 1e-10;  // stop when max |delta theta| falls below this
-  int max_iterations = 20;
+  // Gauss-Newton converges only linearly where the VM cannot reach the RM
+  // (rate about residual / L): the surface, warm-started near its plane,
+  // takes 5-20 iterations and up to ~50 far from it; circle and sphere
+  // under W_p start at the closed form and stop after one
+  int max_iterations = 60;
   // Levenberg damping, relative to the mean diagonal of J^T W J; it keeps
   // joints that W does not see (the twist under W_p) where they are
   double relative_damping = 1e-12;
@@ -50,6 +54,8 @@ Vec6 placement_residual(const VirtualMechanism& vm, const RmPose& rm,
 
 // Iterates eq. 3.15/3.16, delta = (J^T W J)^-1 J^T W r, theta += delta,
 // from *theta (the warm start) and leaves the result in *theta, normalised.
+// The step carries Levenberg-Marquardt damping that adapts to how well the
+// linear model predicted the cost (see control_law.cc).
 PlacementResult place_gauss_newton(const VirtualMechanism& vm,
                                    const RmPose& rm,
                                    const PlacementOptions& options,
