@@ -1,12 +1,15 @@
 // vmhaptics: one command line for the testbed. Each verb prints one JSON
 // object on stdout (or writes CSV files); errors are one line on stderr.
 //
+// Verbs: kin (kinematics of the Omni), ctl (one controller tick).
+//
 // Exit codes: 0 success, 2 bad usage or bad input, 1 any other failure.
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
 
 #include "cli/args.h"
+#include "cli/ctl.h"
 #include "cli/kin.h"
 
 namespace {
@@ -48,6 +51,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string(VMH_VERSION));
   app.require_subcommand(1);
   vmh::cli::register_kin(&app);
+  vmh::cli::register_ctl(&app);
 
   try {
     check_verbs(&app, argc, argv);

@@ -1,17 +1,14 @@
 // The command line as a user runs it: its JSON contract and its errors.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
-#include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "tests/support/cli_run.h"
 #include "tests/support/openhaptics_reference.h"
 
 namespace vmh {
@@ -19,36 +16,8 @@ namespace {
 
 using nlohmann::json;
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-// runs `vmhaptics <args>` through the shell, capturing stdout and stderr
-CliRun run(const std::string& args) {
-  // a file of its own: ctest runs the test cases in parallel processes
-  std::string err_path = ::testing::TempDir() + "vmh_cli_stderr_XXXXXX";
-  const int fd = mkstemp(err_path.data());
-  if (fd < 0) return CliRun{};
-  close(fd);
-  const std::string cmd =
-      std::string(VMH_CLI_PATH) + " " + args + " 2>" + err_path;
-  CliRun r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream err(err_path);
-  std::stringstream ss;
-  ss << err.rdbuf();
-  r.err = ss.str();
-  std::remove(err_path.c_str());
-  return r;
-}
+using testing::CliRun;
+using testing::run;
 
 Vec3 vec3(const json& j) { return Vec3(j[0], j[1], j[2]); }
 

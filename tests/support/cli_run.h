@@ -1,0 +1,51 @@
+// Runs the built command line as a user runs it, for the tests of its verbs.
+// The including target defines VMH_CLI_PATH, the path of build/vmhaptics.
+#ifndef VMHAPTICS_TESTS_SUPPORT_CLI_RUN_H_
+#define VMHAPTICS_TESTS_SUPPORT_CLI_RUN_H_
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace vmh::testing {
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+// runs `vmhaptics <args>` through the shell, capturing stdout and stderr
+inline CliRun run(const std::string& args) {
+  // a file of its own: ctest runs the test cases in parallel processes
+  std::string err_path = ::testing::TempDir() + "vmh_cli_stderr_XXXXXX";
+  const int fd = mkstemp(err_path.data());
+  if (fd < 0) return CliRun{};
+  close(fd);
+  const std::string cmd =
+      std::string(VMH_CLI_PATH) + " " + args + " 2>" + err_path;
+  CliRun r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream err(err_path);
+  std::stringstream ss;
+  ss << err.rdbuf();
+  r.err = ss.str();
+  std::remove(err_path.c_str());
+  return r;
+}
+
+}  // namespace vmh::testing
+
+#endif  // VMHAPTICS_TESTS_SUPPORT_CLI_RUN_H_
