@@ -27,7 +27,7 @@ struct PlacementOptions {
   // (1,1,1,0,0,0) is W_p (eq. 3.21: nearest point, the thesis's theta_V);
   // (0,0,0,1,1,1) is W_o (eq. 3.17: aligned with the stylus, theta_R).
   Vec6 weights = (Vec6() << 1, 1, 1, 0, 0, 0).finished();
-  double tolerance = 1e-10;  // stop when max |delta theta| falls below this
+  double tolerance = 1e-9;  // stop when max |delta theta| falls below this
   // Gauss-Newton converges only linearly where the VM cannot reach the RM
   // (rate about residual / L): the surface, warm-started near its plane,
   // takes 5-20 iterations and up to ~50 far from it; circle and sphere

@@ -14,6 +14,10 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// tangential force below which a held contact never slips, whatever the
+// normal force: keeps rounding-level forces at rest from creeping the contact
+constexpr double kSlipFloor_N = 1e-6;
+
 void require(bool ok, const std::string& field, const std::string& what) {
   if (!ok) {
     throw std::invalid_argument("controller parameter " + field + ": " + what);
@@ -322,7 +326,7 @@ ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept 
       st |= kStatusContactOpen;
       vm_->aligned(rm, &theta_v_);
       out->f_motion.setZero();
-    } else if (locked != 0 && f_t > mu * std::abs(f_n)) {
+    } else if (locked != 0 && f_t > mu * std::abs(f_n) + kSlipFloor_N) {
       theta_v_ = held;
       st_eval = evaluate(rm, 0u, out) | kStatusContactSliding;
     }

@@ -104,6 +104,33 @@ Vec3 VirtualMechanism::geometric_orientation_error(const VmPose& vm,
   return std::atan2(s, c) / s * k;
 }
 
+Mat3 VirtualMechanism::orientation_error_jacobian(const VmPose& vm,
+                                                  const RmPose& rm) const {
+  // e = phi n/s with n = a x u, s = |n|, c = a.u, phi = atan2(s, c). Turning
+  // the link by dw moves u by dw x u, so dn = N dw with N = -[a]x [u]x,
+  // dc = -n.dw, ds = nhat.dn, dphi = c ds - s dc (s^2 + c^2 = 1), and
+  // de = nhat dphi + (phi/s)(I - nhat nhat^T) dn.
+  const Vec3 a = rm.axis.normalized();
+  const Vec3& u = vm.axis;
+  Mat3 ax, ux;
+  ax << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  ux << 0, -u.z(), u.y(), u.z(), 0, -u.x(), -u.y(), u.x(), 0;
+  const Mat3 N = -ax * ux;
+  const Vec3 n = a.cross(u);
+  const double s = n.norm();
+  const double c = a.dot(u);
+  if (s < 1e-8) {
+    // aligned: e ~ n to first order (phi/s -> 1); opposite: the error's
+    // direction is a choice and its derivative is not defined, so use the
+    // same first-order form
+    return N;
+  }
+  const Vec3 nh = n / s;
+  const double phi = std::atan2(s, c);
+  const Eigen::RowVector3d dphi = c * (nh.transpose() * N) + s * n.transpose();
+  return nh * dphi + (phi / s) * (Mat3::Identity() - nh * nh.transpose()) * N;
+}
+
 // -------------------------------------------------------------------- circle
 
 CircleVm::CircleVm(const VmMount& mount, double length)
@@ -162,6 +189,13 @@ Vec3 CircleVm::geometric_orientation_error(const VmPose& vm, const RmPose& rm,
     return Vec3::Zero();
   }
   return n * std::atan2(n.dot(a.cross(vm.axis)), a.dot(vm.axis));
+}
+
+Mat3 CircleVm::orientation_error_jacobian(const VmPose&,
+                                          const RmPose&) const {
+  // the error is an angle about the normal: only that part of dw moves it
+  const Vec3 n = mount_.R.col(2);
+  return n * n.transpose();
 }
 
 void CircleVm::normalize(VmAngles* theta) const {

@@ -117,6 +117,13 @@ class VirtualMechanism {
   virtual Vec3 geometric_orientation_error(const VmPose& vm, const RmPose& rm,
                                            bool* ambiguous) const;
 
+  // The derivative of geometric_orientation_error with respect to a small
+  // rotation dw of the VM's link (d e = M dw), so that M times J_V's angular
+  // rows is the exact Jacobian of the error. M -> I - u u^T as the axes
+  // align; the planar VMs' error turns only about their normal (n n^T).
+  virtual Mat3 orientation_error_jacobian(const VmPose& vm,
+                                          const RmPose& rm) const;
+
   // true for angular joints (wrapped, unbounded or periodic), false for
   // prismatic ones
   virtual bool is_revolute(int joint) const = 0;
@@ -148,6 +155,8 @@ class CircleVm final : public VirtualMechanism {
                                 const VmAngles& theta_r) const override;
   Vec3 geometric_orientation_error(const VmPose& vm, const RmPose& rm,
                                    bool* ambiguous) const override;
+  Mat3 orientation_error_jacobian(const VmPose& vm,
+                                  const RmPose& rm) const override;
   bool is_revolute(int) const override { return true; }
   void normalize(VmAngles* theta) const override;
 };
