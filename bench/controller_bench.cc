@@ -18,6 +18,8 @@
 // between different computations, so the program stops with a message.
 #include <benchmark/benchmark.h>
 
+#include "bench/over_samples.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -81,13 +83,8 @@ const std::vector<Sample>& samples() {
 // cycles through the fixed sample set, one call of f per iteration
 template <typename F>
 void over_samples(benchmark::State& state, F f) {
-  const std::vector<Sample>& set = samples();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    f(set[i]);
-    i = (i + 1) & (kSamples - 1);
-  }
-  state.SetItemsProcessed(state.iterations());
+  static_assert((kSamples & (kSamples - 1)) == 0, "power of two");
+  bench::over_samples(state, samples(), f);
 }
 
 ControllerParams make_params(VmKind kind, PlacementMethod placement,

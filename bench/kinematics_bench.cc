@@ -5,6 +5,8 @@
 // runs are comparable. One iteration is one call; items/s is calls per second.
 #include <benchmark/benchmark.h>
 
+#include "bench/over_samples.h"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -59,13 +61,8 @@ const std::vector<Sample>& samples() {
 // cycles through the fixed sample set, one call of f per iteration
 template <typename F>
 void over_samples(benchmark::State& state, F f) {
-  const std::vector<Sample>& set = samples();
-  std::size_t i = 0;
-  for (auto _ : state) {
-    f(set[i]);
-    i = (i + 1) & (kSamples - 1);
-  }
-  state.SetItemsProcessed(state.iterations());
+  static_assert((kSamples & (kSamples - 1)) == 0, "power of two");
+  bench::over_samples(state, samples(), f);
 }
 
 void BM_omni_fk(benchmark::State& state) {

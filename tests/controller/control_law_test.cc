@@ -20,6 +20,7 @@
 
 #include "controller/omni_kinematics.h"  // wrap_angle
 #include "controller/virtual_mechanism.h"
+#include "tests/support/random_vm.h"
 
 namespace vmh {
 namespace {
@@ -32,18 +33,9 @@ constexpr double kDamping = 1e-13;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-double uniform(std::mt19937* rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(*rng);
-}
-
-Vec3 random_unit(std::mt19937* rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Vec3 v;
-  do {
-    v = Vec3(n(*rng), n(*rng), n(*rng));
-  } while (v.norm() < 1e-6);
-  return v.normalized();
-}
+using testing::random_theta;
+using testing::random_unit;
+using testing::uniform;
 
 // Gaussian 6 x m; full rank with probability one (checked by the SVD below)
 VmJacobian random_jacobian(std::mt19937* rng, int m) {
@@ -414,25 +406,6 @@ std::vector<Case> cases(std::vector<VmKind> kinds) {
   return out;
 }
 
-VmAngles random_theta(const VirtualMechanism& vm, std::mt19937* rng) {
-  VmAngles t(vm.dof());
-  const double L = vm.length();
-  switch (vm.kind()) {
-    case VmKind::kCircle:
-      t << uniform(rng, -kPi, kPi);
-      break;
-    case VmKind::kSphere:
-      t << uniform(rng, -kPi, kPi), uniform(rng, 0.2, kPi - 0.2),
-          uniform(rng, -kPi, kPi);
-      break;
-    case VmKind::kSurface:
-      t << uniform(rng, -2 * L, 2 * L), uniform(rng, -2 * L, 2 * L),
-          uniform(rng, -kPi, kPi), uniform(rng, 0.2, kPi - 0.2),
-          uniform(rng, -kPi, kPi);
-      break;
-  }
-  return t;
-}
 
 // the cost r^T W r, from the residual
 double cost_at(const VirtualMechanism& vm, const RmPose& rm, const Vec6& w,

@@ -7,6 +7,7 @@
 // Every VM is checked with the default mount and with a pivot away from the
 // origin in a turned frame, at a long (50) and a short (0.05) link.
 #include "controller/virtual_mechanism.h"
+#include "tests/support/random_vm.h"
 
 #include <gtest/gtest.h>
 
@@ -74,39 +75,10 @@ std::vector<Case> all_cases() {
   return cases({VmKind::kCircle, VmKind::kSphere, VmKind::kSurface});
 }
 
-double uniform(std::mt19937* rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(*rng);
-}
+using testing::random_theta;
+using testing::random_unit;
+using testing::uniform;
 
-Vec3 random_unit(std::mt19937* rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Vec3 v;
-  do {
-    v = Vec3(n(*rng), n(*rng), n(*rng));
-  } while (v.norm() < 1e-6);
-  return v.normalized();
-}
-
-// random angles away from the sphere's and the surface's poles
-VmAngles random_theta(const VirtualMechanism& vm, std::mt19937* rng) {
-  VmAngles t(vm.dof());
-  const double L = vm.length();
-  switch (vm.kind()) {
-    case VmKind::kCircle:
-      t << uniform(rng, -kPi, kPi);
-      break;
-    case VmKind::kSphere:
-      t << uniform(rng, -kPi, kPi), uniform(rng, 0.2, kPi - 0.2),
-          uniform(rng, -kPi, kPi);
-      break;
-    case VmKind::kSurface:
-      t << uniform(rng, -2 * L, 2 * L), uniform(rng, -2 * L, 2 * L),
-          uniform(rng, -kPi, kPi), uniform(rng, 0.2, kPi - 0.2),
-          uniform(rng, -kPi, kPi);
-      break;
-  }
-  return t;
-}
 
 // vee of the skew part of a (nearly) skew matrix
 Vec3 vee(const Mat3& S) {
