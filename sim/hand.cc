@@ -1,0 +1,108 @@
+#include "sim/hand.h"
+
+#include <Eigen/Eigenvalues>
+#include <cstring>
+
+#include "sim/mujoco_util.h"
+
+namespace vmh::sim {
+namespace {
+
+using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+
+Mat3 quat_to_mat(const mjtNum* q) {
+  RowMat3 R;
+  mju_quat2Mat(R.data(), q);
+  return R;
+}
+
+// inertia of a point mass m at offset r about the origin
+Mat3 point_inertia(double m, const Vec3& r) {
+  return m * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+}
+
+}  // namespace
+
+HandParams hand_params(const CaseConfig& c) {
+  HandParams h;
+  h.mass_kg = c.number("hand_mass_kg");
+  h.inertia_kgm2 = c.vec3("hand_inertia_kgm2");
+  h.k_pos_N_per_m = c.number("hand_k_pos_N_per_m");
+  h.b_pos_Ns_per_m = c.number("hand_b_pos_Ns_per_m");
+  h.k_rot_Nm_per_rad = c.number("hand_k_rot_Nm_per_rad");
+  h.b_rot_Nms_per_rad = c.number("hand_b_rot_Nms_per_rad");
+  return h;
+}
+
+SimHand::SimHand(mjModel* m, mjData* d, const HandParams& params,
+                 const std::string& source)
+    : params_(params) {
+  grip_site_ = require_id(m, mjOBJ_SITE, "grip", source);
+  grip_body_ = m->site_bodyid[grip_site_];
+  const int target_body = require_id(m, mjOBJ_BODY, "hand_target", source);
+  target_mocap_ = m->body_mocapid[target_body];
+  if (target_mocap_ < 0) {
+    throw SimError(source + ": body 'hand_target' must be a mocap body");
+  }
+
+  // the hand, rigidly at the grip: combine the two bodies' mass, centre of
+  // mass and inertia (parallel-axis theorem) in the body frame
+  const int b = grip_body_;
+  const double m_body = m->body_mass[b];
+  const Vec3 c_body(m->body_ipos + 3 * b);
+  const Mat3 R_body = quat_to_mat(m->body_iquat + 4 * b);
+  const Mat3 I_body = R_body * Vec3(m->body_inertia + 3 * b).asDiagonal() *
+                      R_body.transpose();
+  const Vec3 c_hand(m->site_pos + 3 * grip_site_);
+  const Mat3 R_hand = quat_to_mat(m->site_quat + 4 * grip_site_);
+  const Mat3 I_hand =
+      R_hand * params_.inertia_kgm2.asDiagonal() * R_hand.transpose();
+
+  const double mass = m_body + params_.mass_kg;
+  const Vec3 com = (m_body * c_body + params_.mass_kg * c_hand) / mass;
+  const Mat3 I = I_body + point_inertia(m_body, c_body - com) + I_hand +
+                 point_inertia(params_.mass_kg, c_hand - com);
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(I);
+  Mat3 axes = eig.eigenvectors();
+  if (axes.determinant() < 0) axes.col(2) *= -1.0;
+  RowMat3 axes_row = axes;
+
+  m->body_mass[b] = mass;
+  for (int i = 0; i < 3; ++i) {
+    m->body_ipos[3 * b + i] = com[i];
+    m->body_inertia[3 * b + i] = eig.eigenvalues()[i];
+  }
+  mju_mat2Quat(m->body_iquat + 4 * b, axes_row.data());
+  mj_setConst(m, d);
+}
+
+void SimHand::set_target(const mjModel* m, mjData* d,
+                         const HandTargetState& target) {
+  (void)m;
+  target_ = target;
+  RowMat3 R = target.R;
+  for (int i = 0; i < 3; ++i) d->mocap_pos[3 * target_mocap_ + i] = target.p_m[i];
+  mju_mat2Quat(d->mocap_quat + 4 * target_mocap_, R.data());
+}
+
+void SimHand::apply(const mjModel* m, mjData* d) {
+  mju_zero(d->qfrc_applied, m->nv);
+  const Vec3 p(d->site_xpos + 3 * grip_site_);
+  const Mat3 R = Eigen::Map<const RowMat3>(d->site_xmat + 9 * grip_site_);
+  // site velocity, world frame: [angular; linear]
+  mjtNum vel[6];
+  mj_objectVelocity(m, d, mjOBJ_SITE, grip_site_, vel, 0);
+  const Vec3 w(vel[0], vel[1], vel[2]);
+  const Vec3 v(vel[3], vel[4], vel[5]);
+
+  const Eigen::AngleAxisd dR(target_.R * R.transpose());
+  const Vec3 rotvec = dR.angle() * dR.axis();
+  force_N_ = params_.k_pos_N_per_m * (target_.p_m - p) +
+             params_.b_pos_Ns_per_m * (target_.v_m_s - v);
+  torque_Nm_ = params_.k_rot_Nm_per_rad * rotvec +
+               params_.b_rot_Nms_per_rad * (target_.w_rad_s - w);
+  mj_applyFT(m, d, force_N_.data(), torque_Nm_.data(), p.data(), grip_body_,
+             d->qfrc_applied);
+}
+
+}  // namespace vmh::sim

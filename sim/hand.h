@@ -1,0 +1,79 @@
+// The simulated human hand: a 6-DOF impedance (mass, damping, stiffness in
+// translation and rotation) between the stylus grip and a scripted target.
+//
+// The hand's mass and inertia are added to the body that carries the "grip"
+// site, so the model keeps its six degrees of freedom (and its keyframes).
+// The spring-damper is a wrench computed at every physics step from the grip
+// site's pose and velocity and the target's, and applied at the grip through
+// d->qfrc_applied:
+//   F   = K_p (p_target - p_grip) + B_p (v_target - v_grip)
+//   tau = K_r r(R_target R_grip^T) + B_r (w_target - w_grip)
+// with r(.) the rotation vector, all in the world (DH base) frame, SI units.
+// Parameters: models/hand/README.md (REFERENCE.md §5).
+#ifndef VMHAPTICS_SIM_HAND_H_
+#define VMHAPTICS_SIM_HAND_H_
+
+#include <mujoco/mujoco.h>
+
+#include <string>
+
+#include "controller/types.h"
+#include "sim/case_config.h"
+
+namespace vmh::sim {
+
+struct HandParams {
+  double mass_kg = 0.554;
+  Vec3 inertia_kgm2 = Vec3::Constant(2e-4);  // about the grip, grip-site axes
+  double k_pos_N_per_m = 135.0;
+  double b_pos_Ns_per_m = 6.45;
+  double k_rot_Nm_per_rad = 0.5;
+  double b_rot_Nms_per_rad = 0.02;
+};
+
+HandParams hand_params(const CaseConfig& c);
+
+// The target's pose and twist, world (DH base) frame, SI.
+struct HandTargetState {
+  Vec3 p_m = Vec3::Zero();
+  Mat3 R = Mat3::Identity();
+  Vec3 v_m_s = Vec3::Zero();
+  Vec3 w_rad_s = Vec3::Zero();
+};
+
+class SimHand {
+ public:
+  // Finds the "grip" site and the "hand_target" mocap body, adds the hand's
+  // mass to the grip's body, and recomputes the model's constants
+  // (mj_setConst). Throws SimError naming what is missing.
+  SimHand(mjModel* m, mjData* d, const HandParams& params,
+          const std::string& source);
+
+  // Sets the target (and moves the mocap body, for viewing).
+  void set_target(const mjModel* m, mjData* d, const HandTargetState& target);
+
+  // Clears d->qfrc_applied and adds the hand's wrench. Positions and
+  // velocities in d must be current (call from mjcb_control, or after
+  // mj_forward). Allocates nothing.
+  void apply(const mjModel* m, mjData* d);
+
+  // the last wrench applied at the grip, world frame
+  const Vec3& force_N() const { return force_N_; }
+  const Vec3& torque_Nm() const { return torque_Nm_; }
+  const HandParams& params() const { return params_; }
+  int grip_site() const { return grip_site_; }
+  const HandTargetState& target() const { return target_; }
+
+ private:
+  HandParams params_;
+  int grip_site_ = -1;
+  int grip_body_ = -1;
+  int target_mocap_ = -1;
+  HandTargetState target_;
+  Vec3 force_N_ = Vec3::Zero();
+  Vec3 torque_Nm_ = Vec3::Zero();
+};
+
+}  // namespace vmh::sim
+
+#endif  // VMHAPTICS_SIM_HAND_H_

@@ -1,0 +1,140 @@
+#include "sim/hand_script.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sim/mujoco_util.h"
+
+namespace vmh::sim {
+namespace {
+
+constexpr double kTwoPi = 6.28318530717958647692;
+
+Vec3 rotate(const Vec3& v, const Vec3& axis, double angle) {
+  return Eigen::AngleAxisd(angle, axis.normalized()) * v;
+}
+
+// smooth 0 -> 1 with zero slope at both ends
+double smoothstep(double s) {
+  s = std::clamp(s, 0.0, 1.0);
+  return s * s * (3.0 - 2.0 * s);
+}
+
+}  // namespace
+
+HandScript::HandScript(const CaseConfig& c, const VmParams& vm)
+    : name_(c.text("script")), kind_(vm.kind) {
+  pivot_ = vm.pivot_mm;
+  n_ = vm.R_pivot.col(2);
+  length_mm_ = vm.length_mm;
+  off_mm_ = c.number("script_off_mm");
+  misalign_rad_ = c.number("script_misalign_rad");
+  sweep_mm_ = c.number("script_sweep_mm");
+  sweep_rad_ = c.number("script_sweep_rad");
+  const Vec3 dir = c.vec3("script_dir").normalized();
+  const double D = c.number("duration_s");
+
+  // the start pose: on the path, the stylus along `dir` (for the circle only
+  // its projection on the plane counts, so it is aligned there too)
+  if (kind_ == VmKind::kCircle) {
+    const Vec3 in_plane = dir - dir.dot(n_) * n_;
+    if (in_plane.norm() < 1e-6) {
+      throw SimError(c.scene_path() +
+                     ": field 'script_dir' is along the circle's normal; the "
+                     "start pose on the path is undefined");
+    }
+    r0_ = in_plane.normalized();
+  } else if (kind_ == VmKind::kSphere) {
+    r0_ = dir;
+  } else {
+    // the surface: "outward" is the plane's normal, the start pose L above
+    // the plane's reference point with the stylus along the normal
+    r0_ = n_;
+  }
+  axis0_ = kind_ == VmKind::kSurface ? n_ : dir;
+  p0_ = pivot_ + length_mm_ * r0_;
+  // the tangent of the sweep: about the normal for circle and sphere
+  Vec3 t = n_.cross(r0_);
+  if (t.norm() < 1e-6) t = r0_.unitOrthogonal();
+  t0_ = t.normalized();
+
+  if (name_ == "hold") {
+    segments_ = {{"hold", 0.0, D, true}};
+    return;
+  }
+  // the thesis script, in twentieths of the run (20 s by default)
+  const double u = D / 20.0;
+  segments_ = {
+      {"settle", 0.0, 1 * u, true},
+      {"off_out", 1 * u, 3 * u, true},
+      {"off_out_misaligned", 3 * u, 5 * u, true},
+      {"off_in", 5 * u, 7 * u, true},
+      {"on_misaligned_a", 7 * u, 10 * u, true},
+      {"on_misaligned_b", 10 * u, 13 * u, true},
+      {"sweep", 13 * u, 20 * u, false},
+  };
+  blend_s_ = std::min(0.3, 0.25 * u);
+}
+
+int HandScript::segment_at(double t_s) const {
+  for (std::size_t i = 0; i < segments_.size(); ++i) {
+    if (t_s < segments_[i].t1_s) return static_cast<int>(i);
+  }
+  return static_cast<int>(segments_.size()) - 1;
+}
+
+ScriptPose HandScript::raw(int segment, double t_s) const {
+  ScriptPose pose;
+  pose.p_mm = p0_;
+  pose.axis = axis0_;
+  const std::string& name = segments_[static_cast<std::size_t>(segment)].name;
+  // misalignment turns the stylus toward the tangent: for the circle about
+  // its normal (theta_R moves along the path); for the sphere the second
+  // on-path hold tilts it about the tangent instead (the polar angle)
+  const Vec3 m = r0_.cross(t0_);
+  if (name == "off_out") {
+    pose.p_mm = p0_ + off_mm_ * r0_;
+  } else if (name == "off_out_misaligned") {
+    pose.p_mm = p0_ + off_mm_ * r0_;
+    pose.axis = rotate(axis0_, m, misalign_rad_);
+  } else if (name == "off_in") {
+    pose.p_mm = p0_ - off_mm_ * r0_;
+  } else if (name == "on_misaligned_a") {
+    pose.axis = rotate(axis0_, m, misalign_rad_);
+  } else if (name == "on_misaligned_b") {
+    pose.axis = kind_ == VmKind::kSphere
+                    ? rotate(axis0_, t0_, misalign_rad_)
+                    : rotate(axis0_, m, -misalign_rad_);
+  } else if (name == "sweep") {
+    const ScriptSegment& s = segments_[static_cast<std::size_t>(segment)];
+    const double T = s.t1_s - s.t0_s;
+    const double tau = std::max(0.0, t_s - s.t0_s);
+    // one slow pass along the path, four across it, both starting at the
+    // start pose
+    const double phi = sweep_rad_ * std::sin(kTwoPi * tau / T);
+    const double across = sweep_mm_ * std::sin(4.0 * kTwoPi * tau / T);
+    const Vec3 r = rotate(r0_, n_, phi);
+    pose.p_mm = pivot_ + (length_mm_ + across) * r;
+    pose.axis = rotate(axis0_, n_, phi);
+  }
+  return pose;
+}
+
+ScriptPose HandScript::at(double t_s) const {
+  const int k = segment_at(t_s);
+  ScriptPose pose = raw(k, t_s);
+  const ScriptSegment& s = segments_[static_cast<std::size_t>(k)];
+  if (k > 0 && t_s - s.t0_s < blend_s_) {
+    // blend in from where the previous segment ended
+    const ScriptPose from = raw(k - 1, s.t0_s);
+    const double w = smoothstep((t_s - s.t0_s) / blend_s_);
+    pose.p_mm = (1.0 - w) * from.p_mm + w * pose.p_mm;
+    const Eigen::Quaterniond q =
+        Eigen::Quaterniond::Identity().slerp(
+            w, Eigen::Quaterniond::FromTwoVectors(from.axis, pose.axis));
+    pose.axis = (q * from.axis).normalized();
+  }
+  return pose;
+}
+
+}  // namespace vmh::sim

@@ -1,0 +1,69 @@
+// Hand scripts: where the hand tries to put the stylus, as a function of
+// time. They reproduce the thesis's experiments (ch. 4): the RM held off the
+// VM's path, held on it with the stylus misaligned, and swept along and
+// across it.
+//
+// A script gives a wrist-centre position (device frame, mm) and a stylus
+// axis (device frame, unit; the z column of the OpenHaptics stylus
+// transform). The hand's spring pulls toward it, so where the RM ends up
+// depends on the VM's force too; the claims are measured on where it is, not
+// on the target.
+#ifndef VMHAPTICS_SIM_HAND_SCRIPT_H_
+#define VMHAPTICS_SIM_HAND_SCRIPT_H_
+
+#include <string>
+#include <vector>
+
+#include "controller/controller.h"
+#include "sim/case_config.h"
+
+namespace vmh::sim {
+
+struct ScriptPose {
+  Vec3 p_mm = Vec3::Zero();      // wrist centre, device frame
+  Vec3 axis = Vec3::UnitZ();     // stylus axis, device frame
+};
+
+// A named stretch of the script. Claims use its settled window (the second
+// half of a hold, after the transition), never the transition.
+struct ScriptSegment {
+  std::string name;
+  double t0_s = 0.0;
+  double t1_s = 0.0;
+  bool hold = true;  // the target stands still (after its blend-in)
+  double settled_from_s() const { return t0_s + 0.5 * (t1_s - t0_s); }
+};
+
+class HandScript {
+ public:
+  // Builds the script named by c.text("script") for the VM of `vm`
+  // (pivot, L, plane) over c.number("duration_s"). Throws SimError if the
+  // script does not apply to the VM.
+  HandScript(const CaseConfig& c, const VmParams& vm);
+
+  ScriptPose at(double t_s) const;
+  // index of the segment holding t (the last one past the end)
+  int segment_at(double t_s) const;
+  const std::vector<ScriptSegment>& segments() const { return segments_; }
+
+  // the geometry the script is built on: start point on the path, the
+  // outward direction there, the tangent along which misalignment and the
+  // sweep move, the normal of the sweep plane (all device frame)
+  const Vec3& start_mm() const { return p0_; }
+  const Vec3& outward() const { return r0_; }
+  const Vec3& tangent() const { return t0_; }
+
+ private:
+  ScriptPose raw(int segment, double t_s) const;
+
+  std::string name_;
+  std::vector<ScriptSegment> segments_;
+  VmKind kind_;
+  Vec3 pivot_, n_, r0_, t0_, p0_, axis0_;
+  double length_mm_, off_mm_, misalign_rad_, sweep_mm_, sweep_rad_;
+  double blend_s_ = 0.3;
+};
+
+}  // namespace vmh::sim
+
+#endif  // VMHAPTICS_SIM_HAND_SCRIPT_H_

@@ -1,0 +1,50 @@
+// MuJoCo plumbing shared by sim/: owners for mjModel/mjData, a loader that
+// turns MuJoCo's error buffer into an exception naming the file, and readers
+// for the model's <custom> fields.
+#ifndef VMHAPTICS_SIM_MUJOCO_UTIL_H_
+#define VMHAPTICS_SIM_MUJOCO_UTIL_H_
+
+#include <mujoco/mujoco.h>
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace vmh::sim {
+
+// A setup-time error in the simulator (bad scene, bad parameter). The
+// message names the file and the field.
+class SimError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+struct DataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
+using DataPtr = std::unique_ptr<mjData, DataDeleter>;
+
+// Compiles an MJCF file. Throws SimError "<path>: <MuJoCo's message>" when the
+// file is missing or MuJoCo rejects it.
+ModelPtr load_model(const std::string& path);
+
+// Id of a named object, or throws SimError "<what> '<name>' not found in
+// <source>".
+int require_id(const mjModel* m, mjtObj type, const char* name,
+               const std::string& source);
+
+// A <custom><numeric> field: its values, or empty if there is none.
+std::vector<double> custom_numeric(const mjModel* m, const std::string& name);
+// A <custom><text> field, or nullptr if there is none.
+const char* custom_text(const mjModel* m, const std::string& name);
+// Names of every numeric and text custom field of the model.
+std::vector<std::string> custom_field_names(const mjModel* m);
+
+}  // namespace vmh::sim
+
+#endif  // VMHAPTICS_SIM_MUJOCO_UTIL_H_

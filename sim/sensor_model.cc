@@ -1,0 +1,47 @@
+#include "sim/sensor_model.h"
+
+#include <cmath>
+
+#include "controller/device_frame.h"
+
+namespace vmh::sim {
+
+SensorModel::SensorModel(const OmniParams& omni, bool enabled)
+    : enabled_(enabled) {
+  constexpr double kTwoPi = 6.28318530717958647692;
+  // joint ranges are given in the DH convention; the device's gimbal angles
+  // are the DH ones with t4 = -q4, t6 = -q6, and the ranges are symmetric,
+  // so the span is the same; the lower bound is mapped explicitly
+  Joints lo_dh, hi_dh;
+  for (int i = 0; i < 6; ++i) {
+    lo_dh[i] = omni.joint_lower_rad[static_cast<std::size_t>(i)];
+    hi_dh[i] = omni.joint_upper_rad[static_cast<std::size_t>(i)];
+  }
+  const Joints a = dh_to_device_joints(lo_dh);
+  const Joints b = dh_to_device_joints(hi_dh);
+  for (int i = 0; i < 6; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (i < 3) {
+      step_[k] = kTwoPi / omni.encoder_counts_per_rev;
+      lower_[k] = 0.0;
+    } else {
+      const double levels = std::ldexp(1.0, omni.gimbal_pot_bits);
+      step_[k] = std::abs(b[i] - a[i]) / levels;
+      lower_[k] = std::min(a[i], b[i]);
+    }
+    if (!enabled_) step_[k] = 0.0;
+  }
+}
+
+Joints SensorModel::measure(const Joints& q_device_rad) const {
+  if (!enabled_) return q_device_rad;
+  Joints out;
+  for (int i = 0; i < 6; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double rel = q_device_rad[i] - lower_[k];
+    out[i] = lower_[k] + std::round(rel / step_[k]) * step_[k];
+  }
+  return out;
+}
+
+}  // namespace vmh::sim
