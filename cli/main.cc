@@ -1,7 +1,8 @@
 // vmhaptics: one command line for the testbed. Each verb prints one JSON
 // object on stdout (or writes CSV files); errors are one line on stderr.
 //
-// Verbs: kin (kinematics of the Omni), ctl (one controller tick).
+// Verbs: kin (kinematics of the Omni), ctl (one controller tick), run
+// (closed-loop simulation of the thesis cases).
 //
 // Exit codes: 0 success, 2 bad usage or bad input, 1 any other failure.
 #include <CLI/CLI.hpp>
@@ -11,6 +12,7 @@
 #include "cli/args.h"
 #include "cli/ctl.h"
 #include "cli/kin.h"
+#include "cli/run.h"
 
 namespace {
 
@@ -52,6 +54,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   vmh::cli::register_kin(&app);
   vmh::cli::register_ctl(&app);
+  vmh::cli::register_run(&app);
 
   try {
     check_verbs(&app, argc, argv);

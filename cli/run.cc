@@ -1,0 +1,169 @@
+// vmhaptics run <case1..case6|scene.xml> [--duration s] [--out DIR]
+//                [--set name=value ...] [--json]
+// vmhaptics run --all [--out DIR] [--jobs N]
+//
+// Prints a table of the error to the path against the run time (or, with
+// --json, one JSON object holding every case's summary), and writes
+// DIR/<case>/trace.csv and DIR/<case>/summary.json when --out is given.
+// Exit codes: 0 every run finished and every claim passed; 1 a claim failed
+// or a run failed; 2 bad usage or bad input (nothing is written for it).
+#include "cli/run.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "cli/args.h"
+#include "sim/run_case.h"
+
+namespace vmh::cli {
+namespace {
+
+struct RunOptions {
+  std::string target;
+  bool all = false;
+  double duration_s = 0.0;  // 0: the scene's
+  std::string out;
+  std::vector<std::string> sets;
+  int jobs = 0;  // 0: one per core
+  bool json = false;
+};
+
+void print_table(const std::vector<sim::CaseResult>& results) {
+  std::printf("%-8s %10s %10s %10s %10s %9s %9s %8s  %s\n", "case",
+              "sim_s", "wall_s", "rms_mm", "max_mm", "meanF_N", "maxF_N",
+              "on_path", "claims");
+  for (const sim::CaseResult& r : results) {
+    int pass = 0;
+    for (const sim::Claim& c : r.claims) pass += c.pass ? 1 : 0;
+    std::printf("%-8s %10.3f %10.3f %10.3f %10.3f %9.3f %9.3f %7.1f%%  %d/%zu%s\n",
+                r.name.c_str(), r.simulated_s, r.wall_time_s,
+                r.metrics.rms_path_error_mm, r.metrics.max_path_error_mm,
+                r.metrics.mean_force_N, r.metrics.max_force_N,
+                100.0 * r.metrics.time_on_path_s / std::max(r.simulated_s, 1e-9),
+                pass, r.claims.size(), r.all_claims_pass ? "" : "  FAIL");
+    for (const sim::Claim& c : r.claims) {
+      std::printf("    %-4s %-38s %10.4g %s %-8.4g %s\n", c.pass ? "ok" : "FAIL",
+                  c.name.c_str(), c.value, c.comparison.c_str(), c.threshold,
+                  c.unit.c_str());
+    }
+  }
+}
+
+void run(const RunOptions& o) {
+  if (o.all == !o.target.empty()) {
+    throw UsageError("run: give one case or scene, or --all");
+  }
+  if (o.duration_s < 0.0) throw UsageError("--duration: must be > 0");
+  std::vector<std::string> sets = o.sets;
+  if (o.duration_s > 0.0) {
+    sets.push_back("duration_s=" + std::to_string(o.duration_s));
+  }
+
+  // resolve every scene first, so that a bad name writes nothing
+  std::vector<std::pair<std::string, std::string>> jobs;
+  try {
+    if (o.all) {
+      for (const sim::CaseEntry& c : sim::thesis_cases()) {
+        std::string name;
+        jobs.emplace_back(c.name, sim::resolve_scene(c.name, &name));
+      }
+    } else {
+      std::string name;
+      const std::string scene = sim::resolve_scene(o.target, &name);
+      jobs.emplace_back(name, scene);
+    }
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("run: ") + e.what());
+  }
+
+  std::vector<sim::CaseResult> results(jobs.size());
+  std::vector<std::string> errors(jobs.size());
+  std::vector<bool> bad_input(jobs.size(), false);
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t i = next++; i < jobs.size(); i = next++) {
+      try {
+        results[i] = sim::run_case(jobs[i].first, jobs[i].second, sets, o.out);
+      } catch (const sim::SimError& e) {
+        errors[i] = e.what();
+        bad_input[i] = true;
+      } catch (const std::exception& e) {
+        errors[i] = e.what();
+      }
+    }
+  };
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t n_threads = std::min<std::size_t>(
+      jobs.size(), o.jobs > 0 ? static_cast<std::size_t>(o.jobs) : cores);
+  std::vector<std::thread> threads;
+  for (std::size_t t = 1; t < n_threads; ++t) threads.emplace_back(worker);
+  worker();
+  for (std::thread& t : threads) t.join();
+
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    if (!errors[i].empty()) {
+      const std::string msg = "run " + jobs[i].first + ": " + errors[i];
+      if (bad_input[i]) throw UsageError(msg);
+      throw std::runtime_error(msg);
+    }
+  }
+
+  if (o.json) {
+    nlohmann::json all = nlohmann::json::object();
+    for (const sim::CaseResult& r : results) all[r.name] = r.summary;
+    std::cout << all.dump(2) << '\n';
+  } else {
+    print_table(results);
+    if (!o.out.empty()) {
+      std::printf("outputs: %s/<case>/trace.csv and summary.json\n",
+                  o.out.c_str());
+    }
+  }
+  std::cout.flush();
+  std::fflush(stdout);
+
+  std::string failed;
+  for (const sim::CaseResult& r : results) {
+    for (const sim::Claim& c : r.claims) {
+      if (!c.pass) failed += " " + r.name + ":" + c.name;
+    }
+  }
+  if (!failed.empty()) {
+    throw std::runtime_error("run: thesis claim(s) not met:" + failed);
+  }
+}
+
+}  // namespace
+
+void register_run(CLI::App* app) {
+  auto o = std::make_shared<RunOptions>();
+  CLI::App* cmd = app->add_subcommand(
+      "run",
+      "closed-loop simulation of a thesis case (case1..case6) or a scene "
+      "file: the Omni held by a simulated hand, headless; prints the error "
+      "against run time and checks the thesis's claims");
+  cmd->add_option("target", o->target,
+                  "case1..case6, or the path of a scene .xml");
+  cmd->add_flag("--all", o->all, "run the six thesis cases");
+  cmd->add_option("--duration", o->duration_s,
+                  "simulated seconds (default: the scene's duration_s, 20)");
+  cmd->add_option("--out", o->out,
+                  "write DIR/<case>/trace.csv and DIR/<case>/summary.json");
+  cmd->add_option("--set", o->sets,
+                  "override a case parameter, name=value (vectors "
+                  "comma-separated); repeatable. README.md lists the names")
+      ->allow_extra_args(false);
+  cmd->add_option("--jobs", o->jobs,
+                  "cases run in parallel (default: one per core)");
+  cmd->add_flag("--json", o->json,
+                "print every case's summary as one JSON object instead of "
+                "the table");
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace vmh::cli
