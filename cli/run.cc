@@ -47,9 +47,10 @@ void print_table(const std::vector<sim::CaseResult>& results) {
                 100.0 * r.metrics.time_on_path_s / std::max(r.simulated_s, 1e-9),
                 pass, r.claims.size(), r.all_claims_pass ? "" : "  FAIL");
     for (const sim::Claim& c : r.claims) {
-      std::printf("    %-4s %-38s %10.4g %s %-8.4g %s\n", c.pass ? "ok" : "FAIL",
-                  c.name.c_str(), c.value, c.comparison.c_str(), c.threshold,
-                  c.unit.c_str());
+      std::printf("    %-4s %-36s %10.4g %s %-7.4g %-5s at %5.1f mm off\n",
+                  c.pass ? "ok" : "FAIL", c.name.c_str(), c.value,
+                  c.comparison.c_str(), c.threshold, c.unit.c_str(),
+                  c.mean_path_distance_mm);
     }
   }
 }

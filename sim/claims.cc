@@ -124,9 +124,49 @@ std::optional<ControllerParams> reference_params(int thesis_case,
   return ref;
 }
 
+namespace {
+
+std::vector<Claim> measure_claims(int thesis_case,
+                                  const std::vector<TraceRow>& rows,
+                                  const ClosedLoop& loop);
+
+}  // namespace
+
 std::vector<Claim> evaluate_claims(int thesis_case,
                                    const std::vector<TraceRow>& rows,
                                    const ClosedLoop& loop) {
+  std::vector<Claim> claims = measure_claims(thesis_case, rows, loop);
+  for (Claim& c : claims) {
+    std::set<std::string> names;
+    std::size_t start = 0;
+    while (start <= c.window.size()) {
+      const std::size_t comma = c.window.find(',', start);
+      const std::size_t end = comma == std::string::npos ? c.window.size() : comma;
+      names.insert(c.window.substr(start, end - start));
+      start = end + 1;
+    }
+    // the sweep claim uses the whole segment, the others its settled half
+    const bool whole = names.count("sweep") > 0;
+    double sum = 0.0;
+    int n = 0;
+    for (const TraceRow& r : rows) {
+      const ScriptSegment& s =
+          loop.script().segments()[static_cast<std::size_t>(r.segment)];
+      if (names.count(s.name) && (whole || r.t_s >= s.settled_from_s())) {
+        sum += r.d_path_mm;
+        ++n;
+      }
+    }
+    c.mean_path_distance_mm = n > 0 ? sum / n : std::nan("");
+  }
+  return claims;
+}
+
+namespace {
+
+std::vector<Claim> measure_claims(int thesis_case,
+                                  const std::vector<TraceRow>& rows,
+                                  const ClosedLoop& loop) {
   std::vector<Claim> claims;
   if (thesis_case < 1 || thesis_case > 6) return claims;
   const HandScript& script = loop.script();
@@ -295,4 +335,5 @@ std::vector<Claim> evaluate_claims(int thesis_case,
   return claims;
 }
 
+}  // namespace
 }  // namespace vmh::sim

@@ -25,6 +25,9 @@ struct Claim {
   double threshold = 0.0;
   std::string unit;
   int samples = 0;  // servo ticks it was measured on
+  // mean distance of the RM from the path over the window: the claims about
+  // "off the path" depend on how far off (docs/testbed.md)
+  double mean_path_distance_mm = 0.0;
   bool pass = false;
 };
 

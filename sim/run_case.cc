@@ -70,6 +70,7 @@ nlohmann::json claim_json(const Claim& c) {
           {"window", c.window},     {"value", c.value},
           {"comparison", c.comparison}, {"threshold", c.threshold},
           {"unit", c.unit},         {"samples", c.samples},
+          {"mean_path_distance_mm", c.mean_path_distance_mm},
           {"pass", c.pass}};
 }
 
