@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -168,6 +170,28 @@ TEST(ClosedLoopTest, NearestPointOnPathIsTheNearest) {
         ASSERT_GE((p - s).norm(), (p - q).norm() - 1e-9);
       }
     }
+  }
+}
+
+}  // namespace
+}  // namespace vmh::sim
+
+namespace vmh::sim {
+namespace {
+
+// README.md's table of case parameters lists every field the loader knows
+// with its default, so the documented contract cannot drift from the code.
+TEST(CaseParameterDocs, ReadmeListsEveryField) {
+  std::ifstream in(std::string(VMH_MODELS_DIR) + "/../README.md");
+  ASSERT_TRUE(in.good());
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string readme = text.str();
+  for (const FieldSpec& f : case_fields()) {
+    const std::string row = std::string("| `") + f.name + "` | " +
+                            (f.default_value ? f.default_value : "(required)") +
+                            " | " + f.unit + " |";
+    EXPECT_NE(readme.find(row), std::string::npos) << "README.md lacks: " << row;
   }
 }
 
