@@ -65,6 +65,12 @@ const std::vector<FieldSpec>& case_fields() {
        "K_v on the translational error rate (eq. 3.8)"},
       {"placement_weights", false, 6, "1 1 1 0 0 0", "-",
        "diagonal W of the Gauss-Newton placement (eq. 3.15), W_p by default"},
+      {"projection_weights", false, 6, "1 1 1 1 1 1", "-",
+       "diagonal W_A of the force projection (Appendix D), identity in the "
+       "thesis"},
+      {"length_unit_mm", false, 1, "1", "mm",
+       "the controller's length unit: 1 = mm (thesis), 1000 = m; the "
+       "projection depends on it (docs/control.md)"},
       {"error", true, 1, "thesis", "-",
        "orientation error: thesis (eq. 3.32-3.37) or geometric"},
       {"placement", true, 1, "gauss-newton", "-",
@@ -253,6 +259,7 @@ CaseConfig CaseConfig::from_model(const mjModel* m, const std::string& source,
     }
   };
   for (const char* n : {"vm_length_mm", "servo_period_s", "force_limit_N",
+                        "length_unit_mm",
                         "duration_s", "hand_mass_kg"}) {
     positive(n);
   }
@@ -266,8 +273,10 @@ CaseConfig CaseConfig::from_model(const mjModel* m, const std::string& source,
   whole("thesis_case", 0, 6);
   whole("delay_ticks", 0, kMaxDelayTicks);
   whole("quantize", 0, 1);
-  for (double w : c.numbers("placement_weights")) {
-    if (w < 0.0) throw SimError(where("placement_weights") + " must be >= 0");
+  for (const char* n : {"placement_weights", "projection_weights"}) {
+    for (double w : c.numbers(n)) {
+      if (w < 0.0) throw SimError(where(n) + " must be >= 0");
+    }
   }
   for (double i : c.numbers("hand_inertia_kgm2")) {
     if (!(i > 0.0)) throw SimError(where("hand_inertia_kgm2") + " must be > 0");
@@ -309,7 +318,12 @@ ControllerParams controller_params(const CaseConfig& c) {
       thesis_orientation_gain(c.number("k_ornt_multiple"), p.vm.length_mm);
   p.gains.k_vel_Ns_per_mm = c.number("k_vel_Ns_per_mm");
   const std::vector<double> w = c.numbers("placement_weights");
-  for (int i = 0; i < 6; ++i) p.placement_options.weights[i] = w[i];
+  const std::vector<double> wa = c.numbers("projection_weights");
+  for (int i = 0; i < 6; ++i) {
+    p.placement_options.weights[i] = w[i];
+    p.projection_weights[i] = wa[i];
+  }
+  p.length_unit_mm = c.number("length_unit_mm");
   parse_error_formulation(c.text("error").c_str(), &p.error);
   parse_placement_method(c.text("placement").c_str(), &p.placement);
   p.servo_period_s = c.number("servo_period_s");
