@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "controller/device_frame.h"
+#include "sim/plot_svg.h"
 
 namespace vmh::sim {
 namespace fs = std::filesystem;
@@ -234,6 +235,8 @@ CaseResult run_case(const std::string& name, const std::string& scene,
     if (ec) throw SimError(dir.string() + ": " + ec.message());
     write_atomically(dir / "trace.csv", trace_csv(rows, loop));
     write_atomically(dir / "summary.json", result.summary.dump(2) + "\n");
+    write_atomically(dir / "views.svg", views_svg(rows, loop));
+    write_atomically(dir / "history.svg", history_svg(rows, loop));
   }
   return result;
 }

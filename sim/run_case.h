@@ -1,7 +1,8 @@
 // Runs a case from start to end and writes its outputs: DIR/<case>/trace.csv
-// (one row per servo tick) and DIR/<case>/summary.json (metrics and the
-// thesis's claims). Both are written to a temporary name and renamed, so a
-// failed run leaves nothing half-written. README.md documents both formats.
+// (one row per servo tick), DIR/<case>/summary.json (metrics and the
+// thesis's claims), and the plots views.svg and history.svg (plot_svg.h).
+// Each is written to a temporary name and renamed, so a failed run leaves
+// nothing half-written. README.md documents the formats.
 #ifndef VMHAPTICS_SIM_RUN_CASE_H_
 #define VMHAPTICS_SIM_RUN_CASE_H_
 
@@ -41,8 +42,8 @@ struct CaseResult {
 };
 
 // Runs `scene` (with `overrides`) for its duration and, if out_dir is not
-// empty, writes out_dir/<name>/{trace.csv,summary.json}. Throws SimError on
-// bad input (before anything is written).
+// empty, writes out_dir/<name>/{trace.csv, summary.json, views.svg,
+// history.svg}. Throws SimError on bad input (before anything is written).
 CaseResult run_case(const std::string& name, const std::string& scene,
                     const std::vector<std::string>& overrides,
                     const std::string& out_dir);

@@ -38,6 +38,9 @@ TEST(RunCli, WritesTraceAndSummary) {
   ASSERT_TRUE(fs::exists(out / "case1" / "trace.csv"));
   ASSERT_TRUE(fs::exists(out / "case1" / "summary.json"));
   EXPECT_FALSE(fs::exists(out / "case1" / "trace.csv.tmp"));
+  for (const char* svg : {"views.svg", "history.svg"}) {
+    EXPECT_EQ(first_line(out / "case1" / svg).rfind("<svg", 0), 0u) << svg;
+  }
 
   // the documented columns, in order (README.md, "trace.csv")
   const std::string header = first_line(out / "case1" / "trace.csv");
