@@ -2,7 +2,7 @@
 // object on stdout (or writes CSV files); errors are one line on stderr.
 //
 // Verbs: kin (kinematics of the Omni), ctl (one controller tick), run
-// (closed-loop simulation of the thesis cases).
+// (closed-loop simulation of the thesis cases), study (numerical studies).
 //
 // Exit codes: 0 success, 2 bad usage or bad input, 1 any other failure.
 #include <CLI/CLI.hpp>
@@ -13,6 +13,7 @@
 #include "cli/ctl.h"
 #include "cli/kin.h"
 #include "cli/run.h"
+#include "cli/study.h"
 
 namespace {
 
@@ -55,6 +56,7 @@ int main(int argc, char** argv) {
   vmh::cli::register_kin(&app);
   vmh::cli::register_ctl(&app);
   vmh::cli::register_run(&app);
+  vmh::cli::register_study(&app);
 
   try {
     check_verbs(&app, argc, argv);

@@ -80,6 +80,9 @@ const std::vector<FieldSpec>& case_fields() {
       {"physics_step_s", false, 1, "0", "s",
        "MuJoCo step h; 0 keeps the scene's <option timestep>; T/h must be "
        "a whole number"},
+      {"integrator", true, 1, "scene", "-",
+       "MuJoCo integrator: scene (keep the scene's <option integrator>), "
+       "euler, implicit or rk4"},
       {"delay_ticks", false, 1, "0", "ticks",
        "servo ticks between a reading and the torque it produces reaching "
        "the motors"},
@@ -236,6 +239,13 @@ CaseConfig CaseConfig::from_model(const mjModel* m, const std::string& source,
   if (script != "thesis" && script != "hold") {
     throw SimError(where("script") + " must be thesis or hold, got '" + script +
                    "'");
+  }
+  const std::string& integrator = c.text("integrator");
+  if (integrator != "scene" && integrator != "euler" &&
+      integrator != "implicit" && integrator != "rk4") {
+    throw SimError(where("integrator") +
+                   " must be scene, euler, implicit or rk4, got '" +
+                   integrator + "'");
   }
   auto positive = [&](const char* name) {
     if (!(c.number(name) > 0.0)) {

@@ -50,6 +50,10 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
   mjModel* m = model_.get();
   const double h_set = config_.number("physics_step_s");
   if (h_set > 0.0) m->opt.timestep = h_set;
+  const std::string& integrator = config_.text("integrator");
+  if (integrator == "euler") m->opt.integrator = mjINT_EULER;
+  if (integrator == "implicit") m->opt.integrator = mjINT_IMPLICIT;
+  if (integrator == "rk4") m->opt.integrator = mjINT_RK4;
   const double T = config_.number("servo_period_s");
   const double h = m->opt.timestep;
   const double n = std::round(T / h);

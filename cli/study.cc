@@ -1,0 +1,12 @@
+#include "cli/study.h"
+
+namespace vmh::cli {
+
+void register_study(CLI::App* app) {
+  CLI::App* study = app->add_subcommand(
+      "study", "numerical studies: precision, stability, extremes");
+  study->require_subcommand(1);
+  // sub-verbs (cli/study_<name>.cc) register here as they land
+}
+
+}  // namespace vmh::cli

@@ -1,0 +1,25 @@
+// The `study` verb: the numerical studies (docs/numerics.md). Each study is
+// a sub-verb registered by its own file, cli/study_<name>.cc:
+//   vmhaptics study precision   error against run time per integrator
+//   vmhaptics study stability   K_crit of the sampled-data loop vs theory
+//   vmhaptics study extremes    stiff and extreme cases, with named outcomes
+// Each prints one JSON object on stdout and, with --out DIR, writes its
+// tables (CSV, units in the column names) and plots (SVG) under DIR.
+#ifndef VMHAPTICS_CLI_STUDY_H_
+#define VMHAPTICS_CLI_STUDY_H_
+
+#include <CLI/CLI.hpp>
+
+namespace vmh::cli {
+
+// Adds `study` and its sub-verbs to the application.
+void register_study(CLI::App* app);
+
+// One per sub-verb, each adding itself under `study`.
+void register_study_precision(CLI::App* study);
+void register_study_stability(CLI::App* study);
+void register_study_extremes(CLI::App* study);
+
+}  // namespace vmh::cli
+
+#endif  // VMHAPTICS_CLI_STUDY_H_
