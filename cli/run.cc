@@ -10,12 +10,8 @@
 #include "cli/run.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cstdio>
 #include <iostream>
-#include <memory>
-#include <mutex>
-#include <thread>
 
 #include "cli/args.h"
 #include "sim/run_case.h"
@@ -82,36 +78,19 @@ void run(const RunOptions& o) {
     throw UsageError(std::string("run: ") + e.what());
   }
 
-  std::vector<sim::CaseResult> results(jobs.size());
-  std::vector<std::string> errors(jobs.size());
-  std::vector<bool> bad_input(jobs.size(), false);
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    for (std::size_t i = next++; i < jobs.size(); i = next++) {
-      try {
-        results[i] = sim::run_case(jobs[i].first, jobs[i].second, sets, o.out);
-      } catch (const sim::SimError& e) {
-        errors[i] = e.what();
-        bad_input[i] = true;
-      } catch (const std::exception& e) {
-        errors[i] = e.what();
-      }
-    }
-  };
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t n_threads = std::min<std::size_t>(
-      jobs.size(), o.jobs > 0 ? static_cast<std::size_t>(o.jobs) : cores);
-  std::vector<std::thread> threads;
-  for (std::size_t t = 1; t < n_threads; ++t) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
-
-  for (std::size_t i = 0; i < jobs.size(); ++i) {
-    if (!errors[i].empty()) {
-      const std::string msg = "run " + jobs[i].first + ": " + errors[i];
-      if (bad_input[i]) throw UsageError(msg);
+  std::vector<sim::CaseJob> runs;
+  for (const auto& [name, scene] : jobs) {
+    runs.push_back(sim::CaseJob{name, scene, {}, {}, false});
+  }
+  sim::run_cases(&runs, sets, o.out, o.jobs);
+  std::vector<sim::CaseResult> results;
+  for (const sim::CaseJob& j : runs) {
+    if (!j.error.empty()) {
+      const std::string msg = "run " + j.name + ": " + j.error;
+      if (j.bad_input) throw UsageError(msg);
       throw std::runtime_error(msg);
     }
+    results.push_back(j.result);
   }
 
   if (o.json) {

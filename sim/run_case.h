@@ -48,6 +48,22 @@ CaseResult run_case(const std::string& name, const std::string& scene,
                     const std::vector<std::string>& overrides,
                     const std::string& out_dir);
 
+// One run of run_cases(): the case's name and scene, and what came of it.
+struct CaseJob {
+  std::string name;
+  std::string scene;
+  CaseResult result;   // filled when error is empty
+  std::string error;   // the exception's message, if the run threw
+  bool bad_input = false;  // the error was a SimError (bad scene or field)
+};
+
+// Runs every job through run_case() on `threads` threads (0: one per core,
+// never more than there are jobs), each run in its own thread with its own
+// model and data. Exceptions are caught per job and recorded in it.
+void run_cases(std::vector<CaseJob>* jobs,
+               const std::vector<std::string>& overrides,
+               const std::string& out_dir, int threads);
+
 // The trace's column names, in order.
 std::vector<std::string> trace_columns(int vm_dof);
 

@@ -1,0 +1,120 @@
+// The cost of the closed loop (sim/closed_loop.h) against bare MuJoCo on the
+// same model, and the wall time of `vmhaptics run --all`.
+//
+// Issue 4's goals, reported in README.md (never asserted as timed tests):
+// - the loop costs at most 25% over bare mj_step per physics step;
+// - all six cases, 20 simulated seconds each, in under 10 s on 2 cores.
+//
+// Per case (1..6):
+// - BM_BareStep: mj_step on the case's compiled model (hand mass included,
+//   no control callback, motor torques held fixed), starting from the state
+//   the closed loop reaches after 0.2 s, so both start from the same pose.
+// - BM_HandStep: the same with the hand's impedance applied at every step
+//   through mjcb_control: the physics of the scene, without the controller.
+// - BM_ClosedLoopTick: ClosedLoop::tick, one servo period (script, sensor,
+//   controller, delay line, then T/h physics steps with the hand).
+// items/s counts physics steps in all three, so the overhead of the loop is
+// items/s(BM_BareStep) / items/s(BM_ClosedLoopTick) - 1.
+//
+// BM_RunAll: sim::run_cases on the six thesis cases, 20 s each, on two
+// threads, writing nothing; one iteration is one `run --all`.
+#include <benchmark/benchmark.h>
+
+#include <mujoco/mujoco.h>
+
+#include <string>
+#include <vector>
+
+#include "sim/closed_loop.h"
+#include "sim/run_case.h"
+
+namespace vmh::sim {
+namespace {
+
+std::string case_scene(int n) {
+  std::string name;
+  return resolve_scene("case" + std::to_string(n), &name);
+}
+
+// a loop that has run for 0.2 s, so that the Omni is moving and the
+// controller is warm
+ClosedLoop& warm_loop(ClosedLoop* loop) {
+  TraceRow row;
+  for (int i = 0; i < 200; ++i) loop->tick(&row);
+  return *loop;
+}
+
+// `with_hand`: the hand's wrench at every step through mjcb_control
+void step_model(benchmark::State& state, bool with_hand) {
+  ClosedLoop loop(case_scene(static_cast<int>(state.range(0))), {});
+  warm_loop(&loop);
+  const mjModel* m = loop.model();
+  DataPtr d(mj_makeData(m));
+  mj_copyData(d.get(), m, loop.data());
+  // the loop's own callback dispatches only to its own mjData; this one
+  // applies the loop's hand to the copy
+  static thread_local SimHand* hand = nullptr;
+  hand = with_hand ? &loop.hand() : nullptr;
+  mjcb_control = [](const mjModel* mm, mjData* dd) {
+    if (hand != nullptr) hand->apply(mm, dd);
+  };
+  if (!with_hand) mjcb_control = nullptr;
+  for (auto _ : state) mj_step(m, d.get());
+  mjcb_control = nullptr;
+  hand = nullptr;
+  state.SetItemsProcessed(state.iterations());
+  state.counters["time_s"] = d->time;
+}
+
+void BM_BareStep(benchmark::State& state) { step_model(state, false); }
+void BM_HandStep(benchmark::State& state) { step_model(state, true); }
+
+void BM_ClosedLoopTick(benchmark::State& state) {
+  ClosedLoop loop(case_scene(static_cast<int>(state.range(0))), {});
+  warm_loop(&loop);
+  TraceRow row;
+  long ticks = 0;
+  for (auto _ : state) {
+    // the script ends at the run's duration; start again rather than run
+    // past it
+    if (++ticks % loop.ticks_per_run() == 0) {
+      state.PauseTiming();
+      loop.reset();
+      state.ResumeTiming();
+    }
+    loop.tick(&row);
+  }
+  state.SetItemsProcessed(state.iterations() * loop.substeps());
+  state.counters["substeps"] = loop.substeps();
+}
+
+void BM_RunAll(benchmark::State& state) {
+  int claims_failed = 0;
+  for (auto _ : state) {
+    std::vector<CaseJob> jobs;
+    for (const CaseEntry& c : thesis_cases()) {
+      jobs.push_back(CaseJob{c.name, case_scene(static_cast<int>(
+                                         jobs.size() + 1)), {}, {}, false});
+    }
+    run_cases(&jobs, {}, "", 2);
+    for (const CaseJob& j : jobs) {
+      if (!j.error.empty()) {
+        state.SkipWithError(j.error.c_str());
+        return;
+      }
+      claims_failed += j.result.all_claims_pass ? 0 : 1;
+    }
+  }
+  state.counters["cases"] = static_cast<double>(thesis_cases().size());
+  state.counters["claims_failed"] = claims_failed;
+}
+
+BENCHMARK(BM_BareStep)->DenseRange(1, 6);
+BENCHMARK(BM_HandStep)->DenseRange(1, 6);
+BENCHMARK(BM_ClosedLoopTick)->DenseRange(1, 6);
+BENCHMARK(BM_RunAll)->Iterations(1)->UseRealTime()->Unit(benchmark::kSecond);
+
+}  // namespace
+}  // namespace vmh::sim
+
+BENCHMARK_MAIN();
