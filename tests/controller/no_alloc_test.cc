@@ -1,5 +1,6 @@
-// The servo loop allocates nothing and throws nothing: the kinematics and
-// Controller::tick for every mechanism and option.
+// The servo loop allocates nothing and throws nothing: the kinematics,
+// Controller::tick for every mechanism and option, and servo_tick() around
+// it.
 //
 // This binary compiles the controller sources itself with
 // EIGEN_RUNTIME_NO_MALLOC and a throwing eigen_assert (see
@@ -16,6 +17,7 @@
 
 #include "controller/controller.h"
 #include "controller/device_frame.h"
+#include "controller/haptic_device.h"
 #include "controller/omni_kinematics.h"
 #include "tests/support/alloc_counter.h"
 #include "tests/support/eigen_assert_throws.h"
@@ -185,6 +187,68 @@ TEST(NoAlloc, ControllerTick) {
                                << placement_method_name(p.placement);
   }
   EXPECT_EQ(ticks, 12 * 203);
+}
+
+// A device that allocates nothing either: it hands out the angles it is
+// given, fails a read or a write when told to, and keeps the last torque.
+class ScriptedDevice final : public HapticDevice {
+ public:
+  DeviceError read_joints(Joints* q_device_rad) noexcept override {
+    if (read_error != DeviceError::kOk) return read_error;
+    *q_device_rad = q_device;
+    return DeviceError::kOk;
+  }
+  DeviceError write_motor_torques(const Vec3& tau_motor_Nm) noexcept override {
+    written_Nm = tau_motor_Nm;
+    return write_error;
+  }
+  Joints q_device = Joints::Zero();
+  DeviceError read_error = DeviceError::kOk;
+  DeviceError write_error = DeviceError::kOk;
+  Vec3 written_Nm = Vec3::Zero();
+};
+
+// servo_tick over random readings, failed reads (which reset the
+// controller), failed writes and NaN readings, for the circle and the
+// sphere
+TEST(NoAlloc, ServoTick) {
+  static_assert(noexcept(servo_tick(nullptr, nullptr, nullptr)),
+                "servo_tick must be noexcept");
+  const DeviceError errors[] = {DeviceError::kNotConnected, DeviceError::kIo,
+                                DeviceError::kTimeout,
+                                DeviceError::kSensorFault};
+  int zeroed = 0, ticks = 0;
+  for (VmKind kind : {VmKind::kCircle, VmKind::kSphere}) {
+    ControllerParams p;
+    p.vm.kind = kind;
+    p.gains.k_ornt_Nmm_per_rad = thesis_orientation_gain(0.5, 50.0);
+    p.gains.k_vel_Ns_per_mm = 0.002;
+    Controller c(p);
+    ScriptedDevice dev;
+    ControlOutput out;
+    std::vector<Joints> qs = random_configurations(200);
+    qs[50][3] = std::nan("");
+    std::size_t allocations = 0;
+    {
+      NoEigenMalloc guard;
+      AllocationScope scope;
+      for (std::size_t k = 0; k < qs.size(); ++k) {
+        dev.q_device = qs[k];
+        dev.read_error = k % 17 == 3 ? errors[(k / 17) % 4] : DeviceError::kOk;
+        dev.write_error = k % 23 == 5 ? DeviceError::kIo : DeviceError::kOk;
+        ServoTickResult r;
+        EXPECT_NO_THROW(r = servo_tick(&dev, &c, &out));
+        if (r.zeroed) ++zeroed;
+        ++ticks;
+      }
+      allocations = scope.count();
+    }
+    EXPECT_EQ(allocations, 0u) << vm_kind_name(kind);
+  }
+  EXPECT_EQ(ticks, 400);
+  // the error paths were taken: 12 failed reads, 9 failed writes and one
+  // NaN per mechanism (some may coincide)
+  EXPECT_GE(zeroed, 2 * 12);
 }
 
 }  // namespace
