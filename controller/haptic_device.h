@@ -47,7 +47,9 @@ struct ServoTickResult {
   DeviceError read = DeviceError::kOk;
   DeviceError write = DeviceError::kOk;
   ControlStatus control = kStatusOk;
-  // true when zero torque was sent (any device error or controller fault)
+  // true when the controller's torque did not go out: zero was sent in its
+  // place (a failed read, a controller fault), or the write itself failed
+  // (then `write` says why, and what the motors hold is up to the device)
   bool zeroed = false;
 };
 

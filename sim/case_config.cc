@@ -8,12 +8,10 @@
 
 #include "controller/virtual_mechanism.h"
 #include "sim/mujoco_util.h"
+#include "sim/sim_device.h"
 
 namespace vmh::sim {
 namespace {
-
-// 64 servo ticks of delay is 64 ms at 1 kHz, far beyond any USB device
-constexpr int kMaxDelayTicks = 64;
 
 std::string join_names() {
   std::string all;
@@ -135,12 +133,26 @@ CaseConfig CaseConfig::from_model(const mjModel* m, const std::string& source,
   CaseConfig c;
   c.scene_path_ = source;
 
-  // every custom field of the scene must be one we know
-  for (const std::string& name : custom_field_names(m)) {
-    if (find_field(name) == nullptr) {
+  // every custom field of the scene must be one we know, under the tag of
+  // its kind: a number written as <text> (or a word as <numeric>) would
+  // otherwise be skipped and its default used without a word
+  auto check_tag = [&](const char* name, bool as_text) {
+    const FieldSpec* f = find_field(name);
+    if (f == nullptr) {
       throw SimError(source + ": unknown <custom> field '" + name +
                      "' (known: " + join_names() + ")");
     }
+    if (f->is_text != as_text) {
+      throw SimError(source + ": <custom> field '" + name + "' must be a <" +
+                     (f->is_text ? "text" : "numeric") + ">, not a <" +
+                     (as_text ? "text" : "numeric") + ">");
+    }
+  };
+  for (int i = 0; i < m->nnumeric; ++i) {
+    check_tag(m->names + m->name_numericadr[i], false);
+  }
+  for (int i = 0; i < m->ntext; ++i) {
+    check_tag(m->names + m->name_textadr[i], true);
   }
 
   auto store = [&c](const FieldSpec& f, const std::string& value,

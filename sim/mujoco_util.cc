@@ -53,15 +53,4 @@ const char* custom_text(const mjModel* m, const std::string& name) {
   return id < 0 ? nullptr : m->text_data + m->text_adr[id];
 }
 
-std::vector<std::string> custom_field_names(const mjModel* m) {
-  std::vector<std::string> names;
-  for (int i = 0; i < m->nnumeric; ++i) {
-    names.emplace_back(m->names + m->name_numericadr[i]);
-  }
-  for (int i = 0; i < m->ntext; ++i) {
-    names.emplace_back(m->names + m->name_textadr[i]);
-  }
-  return names;
-}
-
 }  // namespace vmh::sim

@@ -42,8 +42,6 @@ int require_id(const mjModel* m, mjtObj type, const char* name,
 std::vector<double> custom_numeric(const mjModel* m, const std::string& name);
 // A <custom><text> field, or nullptr if there is none.
 const char* custom_text(const mjModel* m, const std::string& name);
-// Names of every numeric and text custom field of the model.
-std::vector<std::string> custom_field_names(const mjModel* m);
 
 }  // namespace vmh::sim
 

@@ -25,8 +25,10 @@ SensorModel::SensorModel(const OmniParams& omni, bool enabled)
       step_[k] = kTwoPi / omni.encoder_counts_per_rev;
       lower_[k] = 0.0;
     } else {
-      const double levels = std::ldexp(1.0, omni.gimbal_pot_bits);
-      step_[k] = std::abs(b[i] - a[i]) / levels;
+      // 2^bits levels with both ends of the range among them: 2^bits - 1
+      // steps across the span
+      levels_[k] = std::ldexp(1.0, omni.gimbal_pot_bits);
+      step_[k] = std::abs(b[i] - a[i]) / (levels_[k] - 1.0);
       lower_[k] = std::min(a[i], b[i]);
     }
     if (!enabled_) step_[k] = 0.0;
@@ -39,7 +41,14 @@ Joints SensorModel::measure(const Joints& q_device_rad) const {
   for (int i = 0; i < 6; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const double rel = q_device_rad[i] - lower_[k];
-    out[i] = lower_[k] + std::round(rel / step_[k]) * step_[k];
+    double level = std::round(rel / step_[k]);
+    // a potentiometer cannot read past the ends of its track (a NaN passes
+    // through both comparisons and stays NaN)
+    if (levels_[k] > 0.0) {
+      if (level < 0.0) level = 0.0;
+      if (level > levels_[k] - 1.0) level = levels_[k] - 1.0;
+    }
+    out[i] = lower_[k] + level * step_[k];
   }
   return out;
 }

@@ -18,7 +18,8 @@ class SensorModel {
   SensorModel(const OmniParams& omni, bool enabled);
 
   // t1..t3 rounded to whole encoder counts; t4..t6 rounded to one of
-  // 2^bits levels across the joint's range (the potentiometer's span is
+  // 2^bits levels spanning the joint's range, ends included, and clamped to
+  // them (the potentiometer's span is
   // taken to be the joint's range: an estimate, docs/omni.md).
   Joints measure(const Joints& q_device_rad) const;
 
@@ -29,6 +30,7 @@ class SensorModel {
   bool enabled_;
   std::array<double, 6> step_{};
   std::array<double, 6> lower_{};
+  std::array<double, 6> levels_{};  // potentiometer levels (0: an encoder)
 };
 
 }  // namespace vmh::sim

@@ -20,6 +20,8 @@
 
 namespace vmh::sim {
 
+// the longest delay line: 64 servo ticks is 64 ms at 1 kHz, far beyond any
+// USB or FireWire device (case_config checks delay_ticks against it)
 inline constexpr int kMaxDelayTicks = 64;
 
 class SimDevice final : public HapticDevice {

@@ -204,6 +204,24 @@ TEST_F(CaseConfigTest, UnknownSceneTextFieldIsAnErrorToo) {
   EXPECT_TRUE(contains(msg, "'colour'")) << msg;
 }
 
+// A known field under the other kind's tag is an error, not a silent
+// default: a number written as <text>, and a word written as <numeric>.
+TEST_F(CaseConfigTest, NumberFieldWrittenAsTextIsAnError) {
+  const std::string msg =
+      load_error(kCircle + text_field("k_pos_N_per_mm", "0.6"));
+  EXPECT_TRUE(contains(msg, path())) << msg;
+  EXPECT_TRUE(contains(msg, "'k_pos_N_per_mm'")) << msg;
+  EXPECT_TRUE(contains(msg, "<numeric>")) << msg;
+}
+
+TEST_F(CaseConfigTest, TextFieldWrittenAsNumericIsAnError) {
+  const std::string msg = load_error(numeric_field("vm_kind", "1"));
+  EXPECT_TRUE(contains(msg, path())) << msg;
+  EXPECT_TRUE(contains(msg, "'vm_kind'")) << msg;
+  EXPECT_TRUE(contains(msg, "<text>")) << msg;
+  EXPECT_FALSE(contains(msg, "missing")) << msg;
+}
+
 TEST_F(CaseConfigTest, UnknownSetNameIsNamed) {
   const std::string msg = load_error(kCircle, {"k_pos=1"});
   EXPECT_TRUE(contains(msg, "--set")) << msg;

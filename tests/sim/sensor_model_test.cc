@@ -2,7 +2,8 @@
 // (device convention, rad). Joints t1..t3: optical encoders of 15000 counts
 // per revolution, so a reading is a whole number of counts of 2 pi / 15000
 // rad. Joints t4..t6: potentiometers read with 11 bits across the joint's
-// range, so a reading is one of the levels lower + k range / 2^11.
+// range, so a reading is one of the 2^11 levels lower + k range / (2^11 - 1),
+// k = 0 .. 2047, both ends of the range included.
 //
 // The step sizes are worked out here from OmniParams' fields (and once by
 // hand from the numbers in omni_params.h), and the device-convention range
@@ -37,7 +38,7 @@ double device_lower_rad(const OmniParams& p, int i) {
 double pot_step_rad(const OmniParams& p, int i) {
   const auto k = static_cast<std::size_t>(i);
   return (p.joint_upper_rad[k] - p.joint_lower_rad[k]) /
-         std::pow(2.0, p.gimbal_pot_bits);
+         (std::pow(2.0, p.gimbal_pot_bits) - 1.0);
 }
 
 TEST(SensorModelTest, StepSizes) {
@@ -55,14 +56,14 @@ TEST(SensorModelTest, StepSizes) {
                 pot_step_rad(p, i), 1e-15)
         << "t" << i + 1;
   }
-  // by hand from omni_params.h: ranges 4.90, 2.26, 5.16 rad over 2048
-  EXPECT_NEAR(s.resolution_rad()[3], 4.90 / 2048.0, 1e-15);
-  EXPECT_NEAR(s.resolution_rad()[4], 2.26 / 2048.0, 1e-15);
-  EXPECT_NEAR(s.resolution_rad()[5], 5.16 / 2048.0, 1e-15);
+  // by hand from omni_params.h: ranges 4.90, 2.26, 5.16 rad in 2047 steps
+  EXPECT_NEAR(s.resolution_rad()[3], 4.90 / 2047.0, 1e-15);
+  EXPECT_NEAR(s.resolution_rad()[4], 2.26 / 2047.0, 1e-15);
+  EXPECT_NEAR(s.resolution_rad()[5], 5.16 / 2047.0, 1e-15);
 }
 
 // Readings over the whole range: encoder readings are whole counts, pot
-// readings whole levels within [0, 2^11], and every reading is within half
+// readings whole levels within [0, 2^11 - 1], and every reading is within half
 // a step of the truth.
 TEST(SensorModelTest, ReadingsAreWholeStepsWithinHalfAStep) {
   const OmniParams p;
@@ -90,7 +91,7 @@ TEST(SensorModelTest, ReadingsAreWholeStepsWithinHalfAStep) {
       const double level = (m[i] - device_lower_rad(p, i)) / step;
       EXPECT_LT(off_whole(level), 1e-6) << "t" << i + 1;
       EXPECT_GE(level, -1e-9);
-      EXPECT_LE(level, 2048.0 + 1e-9);
+      EXPECT_LE(level, 2047.0 + 1e-9);
       EXPECT_LE(std::abs(m[i] - t[i]), 0.5 * step * (1 + 1e-9));
     }
   }
@@ -119,13 +120,32 @@ TEST(SensorModelTest, PotLevelsStartAtTheDeviceLowerEnd) {
   p.joint_lower_rad[3] = -1.0;  // q4 in [-1, 2], so t4 = -q4 in [-2, 1]
   p.joint_upper_rad[3] = 2.0;
   const SensorModel s(p, true);
-  const double step = 3.0 / 2048.0;
+  const double step = 3.0 / 2047.0;
   EXPECT_NEAR(s.resolution_rad()[3], step, 1e-15);
   Joints t = Joints::Zero();
-  for (const double level : {0.0, 1.0, 700.0, 2048.0}) {
+  for (const double level : {0.0, 1.0, 700.0, 2046.0}) {
     t[3] = -2.0 + level * step + 0.3 * step;  // a little above the level
     EXPECT_NEAR(s.measure(t)[3], -2.0 + level * step, 1e-12) << level;
   }
+  // the top level is the range's upper end, t4 = 1
+  t[3] = 1.0 - 0.3 * step;
+  EXPECT_NEAR(s.measure(t)[3], 1.0, 1e-12);
+}
+
+// A potentiometer reads no further than the ends of its track: angles past
+// the joint's range read as the nearest end. Encoders have no such end.
+TEST(SensorModelTest, PotReadingsClampToTheRangeEnds) {
+  OmniParams p;
+  p.joint_lower_rad[3] = -1.0;  // t4 in [-2, 1]
+  p.joint_upper_rad[3] = 2.0;
+  const SensorModel s(p, true);
+  Joints t = Joints::Zero();
+  t[3] = 1.4;
+  EXPECT_NEAR(s.measure(t)[3], 1.0, 1e-12);
+  t[3] = -2.7;
+  EXPECT_NEAR(s.measure(t)[3], -2.0, 1e-12);
+  t[0] = 40.0;  // an encoder keeps counting past any range
+  EXPECT_NEAR(s.measure(t)[0], 40.0, 0.5 * kEncoderQuantum_rad);
 }
 
 TEST(SensorModelTest, DisabledPassesTheAnglesThrough) {
