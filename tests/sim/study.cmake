@@ -6,3 +6,12 @@
 vmh_add_test(svg_chart_test sim/svg_chart_test.cc)
 target_link_libraries(svg_chart_test PRIVATE vmhaptics::sim)
 target_include_directories(svg_chart_test PRIVATE ${PROJECT_SOURCE_DIR})
+
+# sim/stability_study.cc: K_crit of the sampled-data wall by simulation
+# against Gil et al.'s bound and the exact discrete loop
+vmh_add_test(stability_study_test sim/stability_study_test.cc)
+target_link_libraries(stability_study_test PRIVATE vmhaptics::sim)
+target_include_directories(stability_study_test PRIVATE ${PROJECT_SOURCE_DIR})
+target_compile_definitions(stability_study_test PRIVATE
+                           VMH_MODELS_DIR="${PROJECT_SOURCE_DIR}/models")
+
