@@ -29,9 +29,11 @@ std::string px(double v) {
   return s;
 }
 
-// a number a reader reads (tick labels)
+// a number a reader reads (tick labels): plain from 0.001 to 1e7
+// ("150000", not "1.5e+05"), else in e-notation
 std::string num(double v) {
-  std::string s = format("%.4g", v);
+  const double a = std::abs(v);
+  std::string s = format(a == 0.0 || (a >= 1e-3 && a < 1e7) ? "%.7g" : "%.4g", v);
   if (s == "-0") s = "0";
   return s;
 }
