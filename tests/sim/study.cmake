@@ -15,3 +15,15 @@ target_include_directories(stability_study_test PRIVATE ${PROJECT_SOURCE_DIR})
 target_compile_definitions(stability_study_test PRIVATE
                            VMH_MODELS_DIR="${PROJECT_SOURCE_DIR}/models")
 
+# `vmhaptics study ...` as a user runs it (tests/cli/): JSON, files, errors
+if(VMH_BUILD_CLI)
+  vmh_add_test(study_stability_test cli/study_stability_test.cc)
+  target_link_libraries(study_stability_test PRIVATE
+                        nlohmann_json::nlohmann_json)
+  target_include_directories(study_stability_test PRIVATE
+                             ${PROJECT_SOURCE_DIR})
+  target_compile_definitions(study_stability_test PRIVATE
+                             VMH_CLI_PATH="$<TARGET_FILE:vmhaptics>"
+                             VMH_MODELS_DIR="${PROJECT_SOURCE_DIR}/models")
+  add_dependencies(study_stability_test vmhaptics)
+endif()
