@@ -15,29 +15,41 @@
 //
 // The wall is bilateral: the spring and damper act on both sides of x = 0,
 // as if the slider were coupled to the wall, so that the loop is linear and
-// its stability a property of (m, b, T, B, K, n) alone. (A one-sided wall
-// is only in contact half the time; its limit is the same in the limit of
-// small oscillations but is harder to classify.)
+// its stability a property of (m, b, T, B, K, n) alone, which is what the
+// theories below are about. (A one-sided wall makes the loop piecewise
+// linear; it is not studied here.)
 //
 // Theory the simulation is compared with:
 //   - Gil, Avello, Rubio and Flórez 2004, "Stability analysis of a 1 DOF
-//     haptic interface using the Routh-Hurwitz criterion" (IEEE TCST 12(4)):
-//     K < (b + B) / (T/2 + t_d), from a first-order expansion in T of the
-//     discrete loop with a backward-difference velocity. It holds when the
-//     plant's time constant m/b and the loop's period 2 pi sqrt(m/K) are long
-//     against T (small bT/m and KT²/m), see k_bound_gil_N_per_m.
+//     haptic interface using the Routh-Hurwitz criterion" (IEEE Trans.
+//     Control Systems Technology 12(4)): K < (b + B)/(T/2 + t_d), their
+//     approximation of the Routh-Hurwitz condition for a short period. The
+//     exact discrete loop (below) puts its error, with no delay, at about
+//     +bT/(6m) from b and -BT/m from B (the backward difference's lag on
+//     the damper); a delay makes the b term a little larger. So it holds to
+//     5% while bT/m and BT/m are small (BT/m < ~0.05); the test says where.
+//     The T/2 is the hold's: with the true velocity sampled instead of the
+//     backward difference, the exact K_crit is 2(b + B)/T too, to first
+//     order (VelocityEstimate::kSampled).
 //   - Colgate and Schenkel 1997, "Passivity of a class of sampled-data
 //     systems: application to haptic interfaces" (J. Robotic Systems 14(1)):
-//     the wall is passive iff b > K T/2 + |B|, i.e. K < 2(b - |B|)/T, a
-//     sufficient condition for stability coupled to any passive human, and
-//     more conservative than stability of the device alone. Abbott and
-//     Okamura 2005 ("Effects of position quantization and sampling rate on
-//     virtual-wall passivity", IEEE T-RO 21(5)) add K < 2 f_c/Δ for Coulomb
-//     friction f_c and position quantum Δ, neither of which the slider has.
+//     the wall is passive iff b > K T/2 + |B|, i.e. K < 2(b - |B|)/T, which
+//     guarantees stability coupled to any passive human and is more
+//     conservative than stability of the device alone (Diolaiti et al.
+//     2006). Abbott and Okamura 2005 ("Effects of position quantization and
+//     sampling rate on virtual-wall passivity", IEEE Trans. Robotics 21(5))
+//     add K < 2 f_c/Δ for Coulomb friction f_c and position quantum Δ,
+//     neither of which the slider has.
 //   - The exact discrete-time loop: the plant m x'' + b x' = F discretised
 //     exactly under the zero-order hold, with the backward-difference and
-//     delay states; K_crit is where its spectral radius reaches 1. The
-//     simulation converges to it as h/T -> 0.
+//     delay states; K_crit is where its spectral radius reaches 1.
+//
+// The simulation converges to the exact loop as h/T -> 0, from above:
+// MuJoCo's semi-implicit Euler moves x with the step's new velocity, so the
+// held force acts h/2 early and K_crit is higher by about h/((1 + 2n) T)
+// (0.1% at the command line's default h = T/1000). The same loop with
+// MuJoCo's step as the plant (PlantModel::kMujocoEuler) is what the
+// simulation computes, exactly: the two K_crit agree to ~1e-6.
 #ifndef VMHAPTICS_SIM_STABILITY_STUDY_H_
 #define VMHAPTICS_SIM_STABILITY_STUDY_H_
 
@@ -150,6 +162,18 @@ class SliderWall {
   // The number of servo ticks run() simulates at stiffness K: enough for
   // kHorizonPeriods periods of the undamped oscillation sqrt(K/m) and at
   // least kMinHorizonTicks.
+  //
+  // Why that is enough near the boundary, where the envelope changes by
+  // only ~1e-4 over the run: run() does not compare peaks (sampled once a
+  // tick, a peak is off by up to (pi/ticks per period)²/2, 0.05% at 100
+  // ticks a period, larger than the signal) but the window sums of
+  // Q_k = x_k² - x_{k-1} x_{k+1}, which for the dominant mode grow as
+  // rho^{2k} with no ripple. What limits it is the other modes (the
+  // backward difference's and the delay line's), which must have died out
+  // before the early window: |z| <= 0.7 in the sets tried, so 0.7^100 ~
+  // 3e-16 at the window's start a third into 300 ticks. Three periods keep
+  // each window a whole period long. The test checks the result against
+  // the discrete loop's spectral radius to 1e-4; it agrees to ~1e-6.
   int horizon_ticks(double k_N_per_m) const;
 
   // One run from x = kInitialDisplacement_m at rest, the controller's
