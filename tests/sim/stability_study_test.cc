@@ -169,7 +169,7 @@ TEST(StabilityStudyTest, SimulationIsTheDiscreteLoop) {
 // and a long run's amplitude.
 TEST(StabilityStudyTest, DecaysBelowAndGrowsAbove) {
   testing::MujocoGuard guard;
-  const StabilityParams p = make(1.0, 2.0, 1e-3, 0.0, 0, 100);
+  const StabilityParams p = make(1.0, 2.0, 1e-3, 0.0, 0, 40);
   const double kc = k_crit_discrete(p, PlantModel::kMujocoEuler).k_crit_N_per_m;
   SliderWall wall(kModel, p);
   // near the boundary: rates of about -/+ (0.01)(b+B)/(2m) = 0.01 1/s
