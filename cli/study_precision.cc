@@ -145,12 +145,14 @@ void run(const PrecisionCli& o) {
               {"substeps_per_tick", row.substeps}};
     j.update(error_json(row.error));
     j.update(Json{{"wall_time_s", row.wall_time_s},
+                  {"cpu_time_s", row.cpu_time_s},
                   {"repeats", row.repeats},
                   {"steps_per_s", row.steps_per_s},
                   {"realtime_factor", row.realtime_factor},
                   {"local_order", number_or_null(row.local_order)},
                   {"used_in_fit", row.used_in_fit},
                   {"on_front", row.on_front},
+                  {"on_front_cpu", row.on_front_cpu},
                   {"is_default", row.is_default},
                   {"mujoco_warnings", row.mujoco_warnings}});
     rows.push_back(j);
@@ -171,13 +173,27 @@ void run(const PrecisionCli& o) {
            {"rms_error_mm", number_or_null(row.error.rms_mm)},
            {"max_error_mm", number_or_null(row.error.max_mm)},
            {"wall_time_s", row.wall_time_s},
-           {"on_front", row.on_front}};
+           {"cpu_time_s", row.cpu_time_s},
+           {"on_front", row.on_front},
+           {"on_front_cpu", row.on_front_cpu}};
+    // the settings that beat it on both error and time
+    Json better = Json::array();
+    for (const sim::PrecisionRow& other : r.rows) {
+      if (other.error.finite && row.error.finite &&
+          other.error.rms_mm < row.error.rms_mm &&
+          other.wall_time_s < row.wall_time_s) {
+        better.push_back({{"integrator", sim::integrator_name(other.integrator)},
+                          {"h_s", other.step_s}});
+      }
+    }
+    def["dominated_by"] = better;
   }
   if (def.empty()) {
     // the default integrator was left out with --integrators
     def = {{"integrator", sim::integrator_name(r.default_integrator)},
            {"h_s", r.default_step_s},
-           {"on_front", nullptr}};
+           {"on_front", nullptr},
+           {"on_front_cpu", nullptr}};
   }
   Json front = Json::array();
   for (const sim::PrecisionRow& row : r.rows) {

@@ -51,7 +51,8 @@ struct PrecisionOptions {
   double reference_step_s = 2e-6;        // RK4
   double reference_check_step_s = 4e-6;  // RK4, bounds the reference's error
   // a run is repeated while the repeats took less than this, up to
-  // max_repeats, and the fastest is reported (the machine is shared)
+  // max_repeats, and the fastest is reported (the machine is shared; the
+  // thread's CPU time is reported beside the wall time for the same reason)
   double min_timing_s = 0.3;
   int max_repeats = 5;
 };
@@ -78,6 +79,7 @@ struct PrecisionRow {
   int substeps = 0;            // physics steps per servo tick
   TrajectoryError error;
   double wall_time_s = 0.0;    // the fastest repeat of the tick loop
+  double cpu_time_s = 0.0;     // its thread CPU time, least of the repeats
   int repeats = 0;
   double steps_per_s = 0.0;    // physics steps per wall second
   double realtime_factor = 0.0;  // simulated s per wall s
@@ -87,6 +89,7 @@ struct PrecisionRow {
   // same integrator (NaN for the largest)
   double local_order = 0.0;
   bool on_front = false;       // Pareto front of (wall time, rms error)
+  bool on_front_cpu = false;   // the same with the CPU time
   int mujoco_warnings = 0;
 };
 
