@@ -8,6 +8,7 @@ void register_study(CLI::App* app) {
   study->require_subcommand(1);
   // sub-verbs (cli/study_<name>.cc) register here as they land
   register_study_precision(study);
+  register_study_leanness(study);
 }
 
 }  // namespace vmh::cli
