@@ -107,6 +107,7 @@ void run(const LeannessCli& o) {
           {"mean_nefc", v.mean_nefc},
           {"max_nefc", v.max_nefc},
           {"scene_geoms", v.scene_geoms},
+          {"render_us_per_tick", v.render_us_per_tick},
           {"max_deviation_mm", v.max_deviation_mm},
           {"mujoco_warnings", v.mujoco_warnings},
       });
@@ -165,7 +166,7 @@ void register_study_leanness(CLI::App* study) {
                   "script is compressed into them (default 2)");
   cmd->add_option("--repeats", o->repeats,
                   "runs per variant, interleaved; the fastest is kept "
-                  "(default 3)");
+                  "(default 5)");
   cmd->add_option("--set", o->sets,
                   "override a case parameter, name=value; repeatable")
       ->allow_extra_args(false);

@@ -133,6 +133,16 @@ void run_variant(VariantLoop* v, int ticks) {
   r.mean_nefc = static_cast<double>(nefc_sum) / nn;
   r.max_nefc = nefc_max;
   r.scene_geoms = v->viewer ? v->viewer->geoms() : 0;
+  if (v->viewer) {
+    // the update alone, as many times as the run had ticks, from where the
+    // run ended (clocking each call inside the run would cost as much as
+    // the call)
+    const double c0 = thread_cpu_s();
+    for (std::size_t k = 0; k < n; ++k) v->viewer->update(m, d);
+    const double us = 1e6 * (thread_cpu_s() - c0) / nn;
+    r.render_us_per_tick =
+        r.render_us_per_tick > 0.0 ? std::min(r.render_us_per_tick, us) : us;
+  }
   int warnings = 0;
   for (int i = 0; i < mjNWARNING; ++i) warnings += d->warning[i].number;
   r.mujoco_warnings = warnings;
@@ -191,8 +201,13 @@ LeannessResult run_leanness_study(const LeannessOptions& o) {
     cl.step_s = first.model()->opt.timestep;
     cl.ticks = first.ticks_per_run();
 
+    // each repeat starts one variant further on, so that no variant always
+    // runs first (cold caches) or right after the same neighbour
     for (int rep = 0; rep < result.repeats; ++rep) {
-      for (VariantLoop& v : loops) run_variant(&v, cl.ticks);
+      for (std::size_t i = 0; i < loops.size(); ++i) {
+        run_variant(&loops[(i + static_cast<std::size_t>(rep)) % loops.size()],
+                    cl.ticks);
+      }
     }
 
     // the controller alone, over the composed run's readings
@@ -251,14 +266,14 @@ std::string leanness_csv(const LeannessResult& r) {
       "case,variant,contacts,gravity,rendering,frictionloss,wall_time_s,"
       "cpu_time_s,steps_per_s,cpu_steps_per_s,realtime_factor,slowdown,"
       "cpu_slowdown,physics_slowdown,controller_cpu_time_s,mean_ncon,max_ncon,"
-      "mean_nefc,max_nefc,colliding_geoms,scene_geoms,max_deviation_mm,"
-      "mujoco_warnings\n";
+      "mean_nefc,max_nefc,colliding_geoms,scene_geoms,render_us_per_tick,"
+      "max_deviation_mm,mujoco_warnings\n";
   char buf[512];
   for (const CaseLeanness& c : r.cases) {
     for (const VariantResult& v : c.variants) {
       std::snprintf(buf, sizeof buf,
                     "%s,%s,%d,%d,%d,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"
-                    "%.6g,%.9g,%.6g,%d,%.6g,%d,%d,%d,%.9g,%d\n",
+                    "%.6g,%.9g,%.6g,%d,%.6g,%d,%d,%d,%.6g,%.9g,%d\n",
                     c.name.c_str(), v.variant.name.c_str(),
                     v.contact_enabled ? 1 : 0, v.gravity_enabled ? 1 : 0,
                     (v.variant.ingredients & kRendering) ? 1 : 0,
@@ -267,7 +282,8 @@ std::string leanness_csv(const LeannessResult& r) {
                     v.realtime_factor, v.slowdown, v.cpu_slowdown,
                     v.physics_slowdown, c.controller_cpu_time_s, v.mean_ncon,
                     v.max_ncon, v.mean_nefc, v.max_nefc, v.colliding_geoms,
-                    v.scene_geoms, v.max_deviation_mm, v.mujoco_warnings);
+                    v.scene_geoms, v.render_us_per_tick, v.max_deviation_mm,
+                    v.mujoco_warnings);
       s += buf;
     }
   }

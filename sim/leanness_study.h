@@ -56,7 +56,7 @@ struct LeannessOptions {
   std::vector<std::pair<std::string, std::string>> scenes;
   std::vector<std::string> overrides;
   double duration_s = 2.0;  // simulated per variant and repeat
-  int repeats = 3;
+  int repeats = 5;
 };
 
 struct VariantResult {
@@ -85,6 +85,10 @@ struct VariantResult {
   double mean_nefc = 0.0;      // constraint rows per servo tick
   int max_nefc = 0;
   int scene_geoms = 0;         // mjvScene geoms after the last update (0: off)
+  // CPU time of one mjv_updateScene (us; 0 without rendering), timed apart
+  // over as many calls as the run has ticks, least over the repeats: the
+  // rendering's cost measured directly, finer than the run's noise
+  double render_us_per_tick = 0.0;
   // how far the variant's wrist centre went from the composed run's, max
   // over ticks (mm): what the ingredient did to the physics
   double max_deviation_mm = 0.0;

@@ -111,6 +111,8 @@ TEST_F(LeannessStudy, RenderingFillsASceneAndChangesNothing) {
   EXPECT_EQ(v.scene_geoms, result_->cases[0].ngeom);
   EXPECT_FALSE(v.contact_enabled);
   EXPECT_FALSE(v.gravity_enabled);
+  EXPECT_GT(v.render_us_per_tick, 0.0);
+  EXPECT_EQ(variant("composed").render_us_per_tick, 0.0);
   // updating a scene reads mjData and writes only the scene
   EXPECT_EQ(v.max_deviation_mm, 0.0);
   EXPECT_GT(variant("all").scene_geoms, 0);
