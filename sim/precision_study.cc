@@ -451,11 +451,12 @@ std::string precision_csv(const PrecisionResult& r) {
 Chart precision_chart(const PrecisionResult& r) {
   Chart c;
   char title[160];
-  std::snprintf(title, sizeof title,
-                "work-precision: %.3g s of the closed loop, T = %.3g ms, "
-                "quantisation off",
+  // centred on the plot area, so kept short
+  std::snprintf(title, sizeof title, "work-precision, %.3g s, T = %.3g ms",
                 r.duration_s, r.servo_period_s * 1e3);
   c.title = title;
+  c.width_px = 820;
+  c.height_px = 480;
   c.x = {"wall time of the run (s)", true};
   c.y = {"RMS wrist-centre error vs RK4 reference (mm)", true};
   for (const OrderFit& f : r.fits) {
@@ -505,7 +506,9 @@ Chart precision_chart(const PrecisionResult& r) {
 
 Chart precision_order_chart(const PrecisionResult& r) {
   Chart c;
-  c.title = "convergence: error against the physics step (dashed: fitted)";
+  c.title = "error against the physics step";
+  c.width_px = 820;
+  c.height_px = 480;
   c.x = {"physics step h (s)", true};
   c.y = {"RMS wrist-centre error vs RK4 reference (mm)", true};
   for (const OrderFit& f : r.fits) {
