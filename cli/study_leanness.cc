@@ -71,6 +71,11 @@ void run(const LeannessCli& o) {
   }
   p.duration_s = o.duration_s;
   p.repeats = o.repeats;
+  for (const std::string& set : o.sets) {
+    if (set.substr(0, set.find('=')) == "duration_s") {
+      throw UsageError("--set duration_s: the study sets it; use --duration");
+    }
+  }
   p.overrides = o.sets;
 
   sim::LeannessResult r;

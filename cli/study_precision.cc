@@ -93,6 +93,13 @@ void run(const PrecisionCli& o) {
   }
   p.reference_step_s = o.reference_step_s;
   p.reference_check_step_s = o.reference_check_step_s;
+  for (const std::string& set : o.sets) {
+    const std::string field = set.substr(0, set.find('='));
+    if (field == "quantize" || field == "integrator" || field == "physics_step_s") {
+      throw UsageError("--set " + field + ": the study sets it for every run "
+                       "(quantize=0; --integrators, --steps)");
+    }
+  }
   p.overrides = o.sets;
 
   // the case's servo period and script length, to check the options against

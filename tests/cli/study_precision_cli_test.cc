@@ -93,6 +93,8 @@ TEST(StudyPrecisionCli, BadOptionsAreNamedAndWriteNothing) {
       {"--reference-step 3e-6", "--reference-step"},
       {"--reference-check-step 1e-6", "--reference-check-step"},
       {"--set no_such_field=1", "--set"},
+      {"--set quantize=1", "--set quantize"},
+      {"--set integrator=euler", "--set integrator"},
   };
   const fs::path out = fresh_dir("precision_bad");
   for (const Bad& b : bad) {
@@ -134,6 +136,7 @@ TEST(StudyLeannessCli, BadOptionsAreNamed) {
       {"--duration -2", "--duration"},
       {"--repeats 0", "--repeats"},
       {"--set quantize=2", "quantize"},
+      {"--set duration_s=3", "--duration"},
   };
   for (const auto& b : bad) {
     const auto r = run(std::string("study leanness ") + b.args);
