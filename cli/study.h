@@ -3,6 +3,7 @@
 //   vmhaptics study precision   error against run time per integrator
 //   vmhaptics study stability   K_crit of the sampled-data loop vs theory
 //   vmhaptics study extremes    stiff and extreme cases, with named outcomes
+//   vmhaptics study leanness    steps/s as composed vs with everything on
 // Each prints one JSON object on stdout and, with --out DIR, writes its
 // tables (CSV, units in the column names) and plots (SVG) under DIR.
 #ifndef VMHAPTICS_CLI_STUDY_H_
@@ -19,6 +20,7 @@ void register_study(CLI::App* app);
 void register_study_precision(CLI::App* study);
 void register_study_stability(CLI::App* study);
 void register_study_extremes(CLI::App* study);
+void register_study_leanness(CLI::App* study);
 
 }  // namespace vmh::cli
 

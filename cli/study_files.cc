@@ -1,0 +1,61 @@
+#include "cli/study_files.h"
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "cli/args.h"
+#include "sim/mujoco_util.h"
+#include "sim/run_case.h"
+
+namespace vmh::cli {
+namespace fs = std::filesystem;
+
+std::string study_scene(const std::string& option, const std::string& value,
+                        std::string* name) {
+  std::string target = value;
+  if (value.size() == 1 && value[0] >= '1' && value[0] <= '9') {
+    target = "case" + value;
+  }
+  try {
+    return sim::resolve_scene(target, name);
+  } catch (const sim::SimError& e) {
+    throw UsageError(option + ": " + e.what());
+  }
+}
+
+std::vector<double> parse_number_list(const std::string& option,
+                                      const std::string& text) {
+  std::vector<double> out;
+  std::string::size_type start = 0;
+  int item = 1;
+  while (true) {
+    const auto comma = text.find(',', start);
+    out.push_back(parse_number(option + " item " + std::to_string(item),
+                               text.substr(start, comma - start)));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+    ++item;
+  }
+  return out;
+}
+
+std::string write_study_file(const std::string& dir, const std::string& name,
+                             const std::string& text) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir + ": " + ec.message());
+  const fs::path path = fs::path(dir) / name;
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw std::runtime_error(tmp.string() + ": cannot open for writing");
+    out << text;
+    if (!out) throw std::runtime_error(tmp.string() + ": write failed");
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) throw std::runtime_error(path.string() + ": " + ec.message());
+  return path.string();
+}
+
+}  // namespace vmh::cli
