@@ -119,6 +119,21 @@ TEST(PrecisionStudy, SmoothLoopShowsTheTextbookOrders) {
     EXPECT_EQ(row.mujoco_warnings, 0) << guard.warnings();
   }
   EXPECT_EQ(guard.warnings(), "");
+
+  // the scene's own setting (Euler at 0.2 ms, tests/sim/scenes/) is not a
+  // rung of the ladder, so the study adds it, marked as the default
+  EXPECT_EQ(r.default_integrator, Integrator::kEuler);
+  EXPECT_DOUBLE_EQ(r.default_step_s, 2e-4);
+  int defaults = 0;
+  for (const PrecisionRow& row : r.rows) {
+    if (!row.is_default) continue;
+    ++defaults;
+    EXPECT_EQ(row.integrator, Integrator::kEuler);
+    EXPECT_DOUBLE_EQ(row.step_s, 2e-4);
+    EXPECT_EQ(row.substeps, 5);
+  }
+  EXPECT_EQ(defaults, 1);
+  ASSERT_EQ(r.rows.size(), 4u + 3u);
 }
 
 TEST(PrecisionStudy, CaseOneAsComposed) {
@@ -128,21 +143,21 @@ TEST(PrecisionStudy, CaseOneAsComposed) {
   o.reference_check_step_s = 5e-5;
   const PrecisionResult r = run_precision_study(o);
 
-  // the scene's own setting is a row, and the study knows it: Euler at
-  // 0.2 ms (models/cases/case1.xml), added to the ladder
-  EXPECT_EQ(r.default_integrator, Integrator::kEuler);
-  EXPECT_DOUBLE_EQ(r.default_step_s, 2e-4);
+  // the scene's own setting is a row, and the study knows it: RK4 at
+  // 1 ms, one step per servo tick (models/cases/case1.xml), already a rung
+  EXPECT_EQ(r.default_integrator, Integrator::kRk4);
+  EXPECT_DOUBLE_EQ(r.default_step_s, 1e-3);
   int defaults = 0;
   for (const PrecisionRow& row : r.rows) {
     if (row.is_default) {
       ++defaults;
-      EXPECT_EQ(row.integrator, Integrator::kEuler);
-      EXPECT_DOUBLE_EQ(row.step_s, 2e-4);
-      EXPECT_EQ(row.substeps, 5);
+      EXPECT_EQ(row.integrator, Integrator::kRk4);
+      EXPECT_DOUBLE_EQ(row.step_s, 1e-3);
+      EXPECT_EQ(row.substeps, 1);
     }
   }
   EXPECT_EQ(defaults, 1);
-  ASSERT_EQ(r.rows.size(), 4u + 3u + 3u);
+  ASSERT_EQ(r.rows.size(), 3u + 3u + 3u);
   EXPECT_EQ(r.ticks, 400);
 
   // first-order methods stay first order with the dry friction on
@@ -204,7 +219,7 @@ TEST(PrecisionStudy, CaseOneAsComposed) {
   EXPECT_TRUE(chart.x.log);
   EXPECT_TRUE(chart.y.log);
   EXPECT_EQ(chart.series[0].label, "euler");
-  EXPECT_EQ(chart.series[0].x.size(), 4u);
+  EXPECT_EQ(chart.series[0].x.size(), 3u);
   EXPECT_EQ(chart.series[3].x.size(), 1u);
 }
 
