@@ -114,8 +114,9 @@ const std::vector<FieldSpec>& case_fields() {
       {"servo_jitter_s", false, 2, "0 0", "s",
        "shortest and longest servo period, each tick's drawn uniformly "
        "and rounded to whole physics steps; the controller is still told "
-       "servo_period_s. 0 0: every period is servo_period_s. A USB Touch "
-       "measured 0.4e-3 2.8e-3 (REFERENCE.md 3)"},
+       "servo_period_s. 0 0: every period is servo_period_s. The extreme "
+       "cases use 0.4e-3 2.8e-3: 2.8 ms is a USB Touch's worst case, the "
+       "range far wider than its measured spread (REFERENCE.md 3)"},
       {"jitter_seed", false, 1, "1", "-",
        "seed of the servo-period draws (whole number)"},
       {"fault", true, 1, "none", "-",
