@@ -7,6 +7,7 @@ void register_study(CLI::App* app) {
       "study", "numerical studies: precision, stability, extremes");
   study->require_subcommand(1);
   // sub-verbs (cli/study_<name>.cc) register here as they land
+  register_study_extremes(study);
   register_study_precision(study);
   register_study_leanness(study);
   register_study_stability(study);

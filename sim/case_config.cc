@@ -91,10 +91,16 @@ const std::vector<FieldSpec>& case_fields() {
       {"duration_s", false, 1, "20", "s", "simulated time of a run"},
       {"script", true, 1, "thesis", "-",
        "hand script: thesis (holds off the path, misaligned on the path, "
-       "sweep) or hold (stay at the start pose)"},
+       "sweep), hold (stay at the start pose), pivot (start at the VM's "
+       "pivot, hold there, then pass through it along script_dir) or spin "
+       "(hold the start point, swing the stylus about the VM's normal by "
+       "+-script_misalign_rad)"},
       {"script_dir", false, 3, "-0.35 0.65 0.65", "-",
        "device-frame direction from the pivot to the start pose; also the "
        "stylus axis there"},
+      {"script_axis", false, 3, "0 0 0", "-",
+       "device-frame stylus axis at the start pose; 0 0 0: along "
+       "script_dir"},
       {"script_off_mm", false, 1, "60", "mm",
        "how far off the path the hand target is held"},
       {"script_misalign_rad", false, 1, "0.5", "rad",
@@ -103,6 +109,32 @@ const std::vector<FieldSpec>& case_fields() {
        "amplitude across the path during the sweep"},
       {"script_sweep_rad", false, 1, "0.5", "rad",
        "amplitude along the path (about the pivot) during the sweep"},
+      {"servo_jitter_s", false, 2, "0 0", "s",
+       "shortest and longest servo period, whole multiples of the physics "
+       "step; each tick's is drawn uniformly among them, and the controller "
+       "is still told servo_period_s. 0 0: every period is servo_period_s. The extreme "
+       "cases use 0.4e-3 2.8e-3: 2.8 ms is a USB Touch's worst case, the "
+       "range far wider than its measured spread (REFERENCE.md 3)"},
+      {"jitter_seed", false, 1, "1", "-",
+       "seed of the servo-period draws (whole number)"},
+      {"fault", true, 1, "none", "-",
+       "injected sensor fault: none, nan (the joint reads NaN), jump (an "
+       "encoder reads 1000 counts high from then on) or stuck (the joint "
+       "keeps its reading)"},
+      {"fault_joint", false, 1, "1", "-",
+       "device joint of the fault, 1..6 (t1..t6); jump: 1..3, the encoders"},
+      {"fault_at_s", false, 1, "1", "s", "when the fault begins"},
+      {"sensor_guard", false, 1, "1", "-",
+       "1: the device layer refuses non-finite readings and latches on an "
+       "encoder step faster than guard_max_speed_rad_s (sensor_fault, zero "
+       "torque); 0: readings pass unchecked"},
+      {"guard_max_speed_rad_s", false, 1, "50", "rad/s",
+       "fastest plausible actuated-joint speed (estimate); the largest "
+       "accepted step is this times the longest servo period"},
+      {"gimbal_limits", false, 1, "1", "-",
+       "1: the gimbal joints q4..q6 stop at their ranges; 0: no limits in "
+       "the model or the controller, so that the wrist can reach its "
+       "singularity q5 = +-pi/2"},
       {"hand_mass_kg", false, 1, "0.554", "kg",
        "hand mass at the grip (van Beek et al. 2015)"},
       {"hand_inertia_kgm2", false, 3, "2e-4 2e-4 2e-4", "kg m^2",
@@ -248,9 +280,17 @@ CaseConfig CaseConfig::from_model(const mjModel* m, const std::string& source,
                    c.text("placement") + "'");
   }
   const std::string& script = c.text("script");
-  if (script != "thesis" && script != "hold") {
-    throw SimError(where("script") + " must be thesis or hold, got '" + script +
+  if (script != "thesis" && script != "hold" && script != "pivot" &&
+      script != "spin") {
+    throw SimError(where("script") +
+                   " must be thesis, hold, pivot or spin, got '" + script +
                    "'");
+  }
+  const std::string& fault = c.text("fault");
+  if (fault != "none" && fault != "nan" && fault != "jump" &&
+      fault != "stuck") {
+    throw SimError(where("fault") + " must be none, nan, jump or stuck, got '" +
+                   fault + "'");
   }
   const std::string& integrator = c.text("integrator");
   if (integrator != "scene" && integrator != "euler" &&
@@ -295,6 +335,20 @@ CaseConfig CaseConfig::from_model(const mjModel* m, const std::string& source,
   whole("thesis_case", 0, 6);
   whole("delay_ticks", 0, kMaxDelayTicks);
   whole("quantize", 0, 1);
+  whole("sensor_guard", 0, 1);
+  whole("gimbal_limits", 0, 1);
+  whole("fault_joint", 1, fault == "jump" ? 3 : 6);
+  whole("jitter_seed", 0, 2147483647.0);
+  positive("guard_max_speed_rad_s");
+  non_negative("fault_at_s");
+  {
+    const std::vector<double> j = c.numbers("servo_jitter_s");
+    const bool off = j[0] == 0.0 && j[1] == 0.0;
+    if (!off && !(j[0] > 0.0 && j[1] >= j[0])) {
+      throw SimError(where("servo_jitter_s") +
+                     " must be 0 0 or a range 0 < min <= max");
+    }
+  }
   for (const char* n : {"placement_weights", "projection_weights"}) {
     for (double w : c.numbers(n)) {
       if (w < 0.0) throw SimError(where(n) + " must be >= 0");

@@ -1,5 +1,6 @@
 #include "sim/closed_loop.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "controller/device_frame.h"
@@ -9,6 +10,8 @@ namespace vmh::sim {
 namespace {
 
 using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+
+constexpr double kPi = 3.14159265358979323846;
 
 // the loop whose hand the control callback drives, per thread
 thread_local ClosedLoop* t_active = nullptr;
@@ -31,6 +34,22 @@ class ActiveLoop {
  private:
   ClosedLoop* previous_;
 };
+
+// splitmix64 (Steele, Lea & Flood, OOPSLA 2014): a fixed, portable sequence,
+// so that a jitter_seed means the same run with any standard library
+std::uint64_t next_random(std::uint64_t* state) {
+  std::uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+bool all_finite(const mjtNum* v, int n) {
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(v[i])) return false;
+  }
+  return true;
+}
 
 // the stylus rotation (DH base frame) whose z axis is `axis_base`, reached
 // from `R_ref` by the smallest rotation
@@ -65,12 +84,46 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
   substeps_ = static_cast<int>(n);
   ticks_per_run_ =
       static_cast<int>(std::llround(config_.number("duration_s") / T));
+  jitter_lo_ = jitter_hi_ = substeps_;
+  const std::vector<double> jitter_s = config_.numbers("servo_jitter_s");
+  if (jitter_s[1] > 0.0) {
+    jitter_ = true;
+    jitter_lo_ = static_cast<int>(std::lround(jitter_s[0] / h));
+    jitter_hi_ = static_cast<int>(std::lround(jitter_s[1] / h));
+    if (jitter_lo_ < 1) {
+      throw SimError(path_ + ": servo_jitter_s's shortest period (" +
+                     std::to_string(jitter_s[0]) +
+                     " s) is less than one physics step (" + std::to_string(h) +
+                     " s)");
+    }
+    // the periods are drawn in whole physics steps: ends that are not whole
+    // steps would be moved without a word
+    for (double end_s : jitter_s) {
+      if (std::abs(std::round(end_s / h) * h - end_s) > 1e-9 * end_s) {
+        throw SimError(path_ + ": servo_jitter_s (" + std::to_string(end_s) +
+                       " s) must be a whole multiple of the physics step (" +
+                       std::to_string(h) + " s); set physics_step_s");
+      }
+    }
+  }
+  jitter_seed_ = static_cast<std::uint64_t>(config_.number("jitter_seed"));
 
   data_.reset(mj_makeData(m));
   if (!data_) throw SimError(path_ + ": mj_makeData failed");
   hand_ = std::make_unique<SimHand>(m, data_.get(), hand_params(config_), path_);
 
   params_ = sim::controller_params(config_);
+  if (config_.number("gimbal_limits") == 0.0) {
+    // the wrist free to turn through its singularity: no limits on q4..q6 in
+    // the model, and ranges that cover every angle for the controller's
+    // check, the start pose's IK and the potentiometers' span
+    for (int i = 3; i < 6; ++i) {
+      const std::string name = "q" + std::to_string(i + 1);
+      m->jnt_limited[require_id(m, mjOBJ_JOINT, name.c_str(), path_)] = 0;
+      params_.omni.joint_lower_rad[static_cast<std::size_t>(i)] = -kPi;
+      params_.omni.joint_upper_rad[static_cast<std::size_t>(i)] = kPi;
+    }
+  }
   try {
     params_.validate();
     controller_ = std::make_unique<Controller>(params_);
@@ -80,6 +133,20 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
   device_ = std::make_unique<SimDevice>(
       m, data_.get(), params_.omni, config_.number("quantize") != 0.0,
       static_cast<int>(config_.number("delay_ticks")), path_);
+  FaultSpec fault;
+  parse_sensor_fault_kind(config_.text("fault"), &fault.kind);
+  fault.joint = static_cast<int>(config_.number("fault_joint")) - 1;
+  fault.at_s = config_.number("fault_at_s");
+  fault.jump_rad = kJumpCounts * 2.0 * kPi / params_.omni.encoder_counts_per_rev;
+  injector_ = std::make_unique<FaultInjector>(device_.get(), fault);
+  GuardParams guard;
+  guard.enabled = config_.number("sensor_guard") != 0.0;
+  guard.max_speed_rad_s = config_.number("guard_max_speed_rad_s");
+  guard.max_period_s = jitter_hi_ * h;
+  guard_ = std::make_unique<ReadingGuard>(injector_.get(), guard);
+  qpos_before_.assign(static_cast<std::size_t>(m->nq), 0.0);
+  dq_.assign(static_cast<std::size_t>(m->nv), 0.0);
+  mv_.assign(static_cast<std::size_t>(m->nv), 0.0);
   script_ = std::make_unique<HandScript>(config_, params_.vm);
 
   // the start pose: the script's first target, the stylus turned the least
@@ -121,7 +188,18 @@ void ClosedLoop::set_reference(const ControllerParams& params) {
 }
 
 double ClosedLoop::time_s() const {
+  if (jitter_) return static_cast<double>(substep_count_) * model_->opt.timestep;
   return static_cast<double>(tick_count_) * params_.servo_period_s;
+}
+
+bool ClosedLoop::finished() const {
+  return time_s() >= config_.number("duration_s") - 0.5 * model_->opt.timestep;
+}
+
+int ClosedLoop::draw_substeps() {
+  if (!jitter_) return substeps_;
+  const auto span = static_cast<std::uint64_t>(jitter_hi_ - jitter_lo_ + 1);
+  return jitter_lo_ + static_cast<int>(next_random(&rng_state_) % span);
 }
 
 void ClosedLoop::reset() {
@@ -129,7 +207,13 @@ void ClosedLoop::reset() {
   mjData* d = data_.get();
   mj_resetData(m, d);
   device_->reset();
+  injector_->reset();
+  guard_->reset();
   tick_count_ = 0;
+  substep_count_ = 0;
+  rng_state_ = jitter_seed_;
+  energy_motor_J_ = 0.0;
+  energy_hand_J_ = 0.0;
   controller_->reset();
   if (reference_) reference_->reset();
   // write the start angles through the joint addresses
@@ -161,12 +245,14 @@ void ClosedLoop::set_hand_target(double t_s) {
     *R_grip = R * R_site;
   };
   HandTargetState target;
-  target_at(t_s, &target.p_m, &target.R);
+  // past the script's end the hand holds its last target still
+  const double t_end_s = config_.number("duration_s");
+  target_at(std::min(t_s, t_end_s), &target.p_m, &target.R);
   // the target's velocity by a forward difference over a small interval
   const double dt = 1e-5;
   Vec3 p2;
   Mat3 R2;
-  target_at(t_s + dt, &p2, &R2);
+  target_at(std::min(t_s + dt, t_end_s), &p2, &R2);
   target.v_m_s = (p2 - target.p_m) / dt;
   const Eigen::AngleAxisd dR(R2 * target.R.transpose());
   target.w_rad_s = dR.angle() * dR.axis() / dt;
@@ -217,12 +303,15 @@ void ClosedLoop::tick(TraceRow* row) {
   const double t = time_s();
   row->t_s = t;
   set_hand_target(t);
-  row->segment = script_->segment_at(t);
-  row->hand_target = script_->at(t);
+  const double t_script = std::min(t, config_.number("duration_s"));
+  row->segment = script_->segment_at(t_script);
+  row->hand_target = script_->at(t_script);
 
-  row->servo = servo_tick(device_.get(), controller_.get(), &row->out);
-  row->q_dh = device_to_dh_joints(device_->sensor().measure(
-      dh_to_device_joints(device_->true_q_dh())));
+  injector_->set_time_s(t);
+  row->servo = servo_tick(guard_.get(), controller_.get(), &row->out);
+  row->q_dh = device_to_dh_joints(injector_->last_reading());
+  row->fault_injected = injector_->active();
+  row->guard = guard_->last_fault();
   if (reference_) {
     reference_->tick(row->q_dh, &reference_out_);
     row->force_reference_N = reference_out_.force_device_N;
@@ -230,15 +319,32 @@ void ClosedLoop::tick(TraceRow* row) {
   row->motor_torque_Nm = device_->motor_torque_Nm();
   row->d_path_mm = distance_to_path_mm(row->out.p_rm_mm);
   const OmniParams& omni = params_.omni;
-  row->p_true_mm =
-      base_to_device_mm(omni, omni_fk(omni, device_->true_q_dh()).p_base_m);
+  row->q_true_dh = device_->true_q_dh();
+  row->p_true_mm = base_to_device_mm(omni, omni_fk(omni, row->q_true_dh).p_base_m);
   row->nearest_true_mm = nearest_on_path_mm(row->p_true_mm);
 
   mjModel* m = model_.get();
   mjData* d = data_.get();
-  for (int i = 0; i < substeps_; ++i) mj_step(m, d);
+  const int n = draw_substeps();
+  for (int i = 0; i < n; ++i) {
+    mju_copy(qpos_before_.data(), d->qpos, m->nq);
+    mj_step(m, d);
+    // the true motion over the step, and the work of the forces held on it
+    mj_differentiatePos(m, dq_.data(), 1.0, qpos_before_.data(), d->qpos);
+    energy_motor_J_ += mju_dot(d->qfrc_actuator, dq_.data(), m->nv);
+    energy_hand_J_ += mju_dot(d->qfrc_applied, dq_.data(), m->nv);
+  }
+  row->substeps = n;
+  row->period_s = n * m->opt.timestep;
+  row->energy_motor_J = energy_motor_J_;
+  row->energy_hand_J = energy_hand_J_;
+  mj_mulM(m, d, mv_.data(), d->qvel);
+  row->kinetic_J = 0.5 * mju_dot(d->qvel, mv_.data(), m->nv);
+  row->state_finite = all_finite(d->qpos, m->nq) && all_finite(d->qvel, m->nv) &&
+                      all_finite(d->qacc, m->nv) && all_finite(d->ctrl, m->nu);
   row->hand_force_N = base_to_device_vector(hand_->force_N());
   ++tick_count_;
+  substep_count_ += n;
 }
 
 }  // namespace vmh::sim

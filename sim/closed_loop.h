@@ -9,11 +9,28 @@
 //   3. MuJoCo steps n = T / h times with d->ctrl held (zero-order hold); the
 //      hand's wrench is recomputed at every step (and at every RK4 stage)
 //      from mjcb_control.
+// servo_tick talks to the device through two decorators (sim/fault_injector.h):
+// ReadingGuard (the device layer's plausibility check, `sensor_guard`) over
+// FaultInjector (the case's `fault`, none by default) over SimDevice.
+//
+// Servo jitter (`servo_jitter_s`): each tick's true period is drawn from
+// [min, max] in whole physics steps, and the torque is held over it; the
+// controller is still told T, as a servo loop that does not time itself
+// would be, so its e_dot is off by the ratio of the periods.
+//
+// Passivity observer (Hannaford & Ryu 2002, IEEE TRA 18(1)): the energy the
+// motors put into the device, E = sum over physics steps of
+// qfrc_actuator . (q_after - q_before), with qfrc_actuator the torque held
+// over the step and q the true joint angles. The motor torque is constant
+// over a step (ZOH, fixed tendons), so this is the exact work along the
+// integrated motion for any integrator. The hand's work is summed the same
+// way from qfrc_applied (exact for Euler; for RK4 the last stage's wrench).
 // The hand's callback is found through a thread-local pointer, so loops in
 // different threads do not disturb each other.
 #ifndef VMHAPTICS_SIM_CLOSED_LOOP_H_
 #define VMHAPTICS_SIM_CLOSED_LOOP_H_
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -22,6 +39,7 @@
 #include "controller/controller.h"
 #include "controller/haptic_device.h"
 #include "sim/case_config.h"
+#include "sim/fault_injector.h"
 #include "sim/hand.h"
 #include "sim/hand_script.h"
 #include "sim/mujoco_util.h"
@@ -32,7 +50,10 @@ namespace vmh::sim {
 // One servo tick of a run. Device frame and mm unless named.
 struct TraceRow {
   double t_s = 0.0;
-  Joints q_dh = Joints::Zero();   // as the controller received them (rad)
+  // the reading the device layer produced (rad): what the controller
+  // received unless the guard refused it (an injected fault included; NaN
+  // if the read itself failed)
+  Joints q_dh = Joints::Zero();
   ControlOutput out;              // the controller's output for this tick
   ServoTickResult servo;
   Vec3 motor_torque_Nm = Vec3::Zero();  // held by the motors (after delay)
@@ -48,6 +69,21 @@ struct TraceRow {
   // the force a reference gain set would have asked for at the same reading
   // (for claims that compare cases); NaN when there is none
   Vec3 force_reference_N = Vec3::Constant(std::nan(""));
+
+  // MuJoCo's joint angles at the start of the tick, DH (rad)
+  Joints q_true_dh = Joints::Zero();
+  // the true period of this tick (servo jitter) and its physics steps
+  double period_s = 0.0;
+  int substeps = 0;
+  bool fault_injected = false;            // the injector corrupted the reading
+  GuardFault guard = GuardFault::kNone;   // what the device layer's check found
+  // passivity observer: energy put into the device since t = 0 by the
+  // motors and by the hand, at the end of this tick, J (see above)
+  double energy_motor_J = 0.0;
+  double energy_hand_J = 0.0;
+  double kinetic_J = 0.0;  // the mechanism's kinetic energy after the tick
+  // qpos, qvel, qacc and ctrl all finite after the tick
+  bool state_finite = true;
 };
 
 class ClosedLoop {
@@ -65,7 +101,9 @@ class ClosedLoop {
   // cleared.
   void reset();
 
-  // Advances one servo period and describes it in *row.
+  // Advances one servo period and describes it in *row. Past duration_s
+  // (a run continued beyond its script) the hand holds the script's last
+  // target, at rest.
   void tick(TraceRow* row);
 
   // Another gain set evaluated on every reading, without acting
@@ -73,8 +111,20 @@ class ClosedLoop {
   void set_reference(const ControllerParams& params);
 
   double time_s() const;
+  // the run's length in ticks at the nominal period; with servo jitter the
+  // count differs, so loop until finished()
   int ticks_per_run() const { return ticks_per_run_; }
+  // whether time_s() has reached duration_s
+  bool finished() const;
+  // physics steps per tick at the nominal period
   int substeps() const { return substeps_; }
+  // the range of physics steps per tick (both substeps() without jitter)
+  int substeps_min() const { return jitter_lo_; }
+  int substeps_max() const { return jitter_hi_; }
+  bool jitter() const { return jitter_; }
+  // the passivity observer's totals so far, J (TraceRow says what they are)
+  double energy_motor_J() const { return energy_motor_J_; }
+  double energy_hand_J() const { return energy_hand_J_; }
   const CaseConfig& config() const { return config_; }
   const ControllerParams& controller_params() const { return params_; }
   const HandScript& script() const { return *script_; }
@@ -82,6 +132,8 @@ class ClosedLoop {
   const mjModel* model() const { return model_.get(); }
   mjData* data() { return data_.get(); }
   SimDevice& device() { return *device_; }
+  FaultInjector& injector() { return *injector_; }
+  ReadingGuard& guard() { return *guard_; }
   SimHand& hand() { return *hand_; }
 
   // distance (mm) from a device-frame point to the VM's path: the circle,
@@ -96,6 +148,8 @@ class ClosedLoop {
 
  private:
   void set_hand_target(double t_s);
+  // the next tick's physics steps (drawn when jittered)
+  int draw_substeps();
 
   std::string path_;
   ModelPtr model_;
@@ -104,6 +158,8 @@ class ClosedLoop {
   ControllerParams params_;
   std::unique_ptr<SimHand> hand_;
   std::unique_ptr<SimDevice> device_;
+  std::unique_ptr<FaultInjector> injector_;
+  std::unique_ptr<ReadingGuard> guard_;
   std::unique_ptr<Controller> controller_;
   std::unique_ptr<Controller> reference_;
   std::unique_ptr<HandScript> script_;
@@ -113,6 +169,16 @@ class ClosedLoop {
   int substeps_ = 1;
   int ticks_per_run_ = 0;
   long tick_count_ = 0;
+  // servo jitter: steps per tick drawn from [lo, hi]; the generator's state
+  bool jitter_ = false;
+  int jitter_lo_ = 1, jitter_hi_ = 1;
+  std::uint64_t jitter_seed_ = 1;
+  std::uint64_t rng_state_ = 1;
+  long substep_count_ = 0;  // physics steps since t = 0
+  // passivity observer
+  double energy_motor_J_ = 0.0;
+  double energy_hand_J_ = 0.0;
+  std::vector<mjtNum> qpos_before_, dq_, mv_;
 };
 
 }  // namespace vmh::sim

@@ -52,6 +52,10 @@ HandScript::HandScript(const CaseConfig& c, const VmParams& vm)
     r0_ = n_;
   }
   axis0_ = kind_ == VmKind::kSurface ? n_ : dir;
+  // an explicit stylus axis, for poses the direction alone cannot give (the
+  // stylus along the forearm, or turned away from the link)
+  const Vec3 axis_set = c.vec3("script_axis");
+  if (axis_set.norm() > 1e-9) axis0_ = axis_set.normalized();
   p0_ = pivot_ + length_mm_ * r0_;
   // the tangent of the sweep: about the normal for circle and sphere
   Vec3 t = n_.cross(r0_);
@@ -60,6 +64,20 @@ HandScript::HandScript(const CaseConfig& c, const VmParams& vm)
 
   if (name_ == "hold") {
     segments_ = {{"hold", 0.0, D, true}};
+    return;
+  }
+  if (name_ == "pivot") {
+    // RM at the pivot, where theta_V is undefined (LL = 0 in §3.4.1), then
+    // through it: two passes along r0 from one side of the path to the other
+    segments_ = {{"at_pivot", 0.0, 0.4 * D, true},
+                 {"through_pivot", 0.4 * D, D, false}};
+    blend_s_ = std::min(0.3, 0.05 * D);
+    return;
+  }
+  if (name_ == "spin") {
+    // the point held, the stylus swung about the VM's normal
+    segments_ = {{"settle", 0.0, 0.1 * D, true}, {"spin", 0.1 * D, D, false}};
+    blend_s_ = std::min(0.3, 0.025 * D);
     return;
   }
   // the thesis script, in twentieths of the run (20 s by default)
@@ -92,7 +110,20 @@ ScriptPose HandScript::raw(int segment, double t_s) const {
   // its normal (theta_R moves along the path); for the sphere the second
   // on-path hold tilts it about the tangent instead (the polar angle)
   const Vec3 m = r0_.cross(t0_);
-  if (name == "off_out") {
+  // the pivot and spin scripts: two full swings over the segment, starting
+  // where the previous segment ended
+  auto two_swings = [&]() {
+    const ScriptSegment& seg = segments_[static_cast<std::size_t>(segment)];
+    const double u = std::max(0.0, t_s - seg.t0_s) / (seg.t1_s - seg.t0_s);
+    return std::sin(2.0 * kTwoPi * u);
+  };
+  if (name == "at_pivot") {
+    pose.p_mm = pivot_;
+  } else if (name == "through_pivot") {
+    pose.p_mm = pivot_ + length_mm_ * two_swings() * r0_;
+  } else if (name == "spin") {
+    pose.axis = rotate(axis0_, n_, misalign_rad_ * two_swings());
+  } else if (name == "off_out") {
     pose.p_mm = p0_ + off_mm_ * r0_;
   } else if (name == "off_out_misaligned") {
     pose.p_mm = p0_ + off_mm_ * r0_;

@@ -1,7 +1,10 @@
 // Hand scripts: where the hand tries to put the stylus, as a function of
 // time. They reproduce the thesis's experiments (ch. 4): the RM held off the
 // VM's path, held on it with the stylus misaligned, and swept along and
-// across it.
+// across it. Two more scripts stress the controller where it is weakest:
+// `pivot` puts the RM at the VM's pivot and drives it through (theta_V
+// undefined), `spin` swings the stylus about the VM's normal (the thesis
+// orientation error can wrap through +-pi).
 //
 // A script gives a wrist-centre position (device frame, mm) and a stylus
 // axis (device frame, unit; the z column of the OpenHaptics stylus

@@ -157,10 +157,16 @@ CaseResult run_case(const std::string& name, const std::string& scene,
   if (auto ref = reference_params(thesis_case, loop.controller_params())) {
     loop.set_reference(*ref);
   }
-  std::vector<TraceRow> rows(static_cast<std::size_t>(loop.ticks_per_run()));
+  // with servo jitter the number of ticks is not known ahead: run until the
+  // simulated time is up
+  std::vector<TraceRow> rows;
+  rows.reserve(static_cast<std::size_t>(loop.ticks_per_run()));
 
   const auto start = std::chrono::steady_clock::now();
-  for (TraceRow& r : rows) loop.tick(&r);
+  while (!loop.finished()) {
+    rows.emplace_back();
+    loop.tick(&rows.back());
+  }
   const auto stop = std::chrono::steady_clock::now();
   result.wall_time_s = std::chrono::duration<double>(stop - start).count();
   result.simulated_s = loop.time_s();
