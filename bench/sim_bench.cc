@@ -14,7 +14,9 @@
 // - BM_ClosedLoopTick: ClosedLoop::tick, one servo period (script, sensor,
 //   controller, delay line, then T/h physics steps with the hand).
 // items/s counts physics steps in all three, so the overhead of the loop is
-// items/s(BM_BareStep) / items/s(BM_ClosedLoopTick) - 1.
+// items/s(BM_BareStep) / items/s(BM_ClosedLoopTick) - 1. The second argument
+// is the physics setting: 0 the scene's own (RK4, h = T = 1 ms), 1 the
+// Euler step at 0.2 ms the scenes used before the precision study.
 //
 // BM_RunAll: sim::run_cases on the six thesis cases, 20 s each, on two
 // threads, writing nothing; one iteration is one `run --all`.
@@ -22,6 +24,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -36,6 +39,11 @@ std::string case_scene(int n) {
   return resolve_scene("case" + std::to_string(n), &name);
 }
 
+std::vector<std::string> setting(int64_t which) {
+  if (which == 0) return {};
+  return {"integrator=euler", "physics_step_s=0.0002"};
+}
+
 // a loop that has run for 0.2 s, so that the Omni is moving and the
 // controller is warm
 ClosedLoop& warm_loop(ClosedLoop* loop) {
@@ -46,7 +54,8 @@ ClosedLoop& warm_loop(ClosedLoop* loop) {
 
 // `with_hand`: the hand's wrench at every step through mjcb_control
 void step_model(benchmark::State& state, bool with_hand) {
-  ClosedLoop loop(case_scene(static_cast<int>(state.range(0))), {});
+  ClosedLoop loop(case_scene(static_cast<int>(state.range(0))),
+                  setting(state.range(1)));
   warm_loop(&loop);
   const mjModel* m = loop.model();
   DataPtr d(mj_makeData(m));
@@ -70,7 +79,8 @@ void BM_BareStep(benchmark::State& state) { step_model(state, false); }
 void BM_HandStep(benchmark::State& state) { step_model(state, true); }
 
 void BM_ClosedLoopTick(benchmark::State& state) {
-  ClosedLoop loop(case_scene(static_cast<int>(state.range(0))), {});
+  ClosedLoop loop(case_scene(static_cast<int>(state.range(0))),
+                  setting(state.range(1)));
   warm_loop(&loop);
   TraceRow row;
   long ticks = 0;
@@ -109,9 +119,14 @@ void BM_RunAll(benchmark::State& state) {
   state.counters["claims_failed"] = claims_failed;
 }
 
-BENCHMARK(BM_BareStep)->DenseRange(1, 6);
-BENCHMARK(BM_HandStep)->DenseRange(1, 6);
-BENCHMARK(BM_ClosedLoopTick)->DenseRange(1, 6);
+// every case in the scene's setting, and cases 1 and 6 in the old one
+void cases_and_settings(benchmark::internal::Benchmark* b) {
+  for (int c = 1; c <= 6; ++c) b->Args({c, 0});
+  for (int c : {1, 6}) b->Args({c, 1});
+}
+BENCHMARK(BM_BareStep)->Apply(cases_and_settings);
+BENCHMARK(BM_HandStep)->Apply(cases_and_settings);
+BENCHMARK(BM_ClosedLoopTick)->Apply(cases_and_settings);
 BENCHMARK(BM_RunAll)->Iterations(1)->UseRealTime()->Unit(benchmark::kSecond);
 
 }  // namespace

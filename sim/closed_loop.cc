@@ -84,6 +84,7 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
   substeps_ = static_cast<int>(n);
   ticks_per_run_ =
       static_cast<int>(std::llround(config_.number("duration_s") / T));
+  duration_s_ = config_.number("duration_s");
   jitter_lo_ = jitter_hi_ = substeps_;
   const std::vector<double> jitter_s = config_.numbers("servo_jitter_s");
   if (jitter_s[1] > 0.0) {
@@ -193,7 +194,7 @@ double ClosedLoop::time_s() const {
 }
 
 bool ClosedLoop::finished() const {
-  return time_s() >= config_.number("duration_s") - 0.5 * model_->opt.timestep;
+  return time_s() >= duration_s_ - 0.5 * model_->opt.timestep;
 }
 
 int ClosedLoop::draw_substeps() {
@@ -246,7 +247,7 @@ void ClosedLoop::set_hand_target(double t_s) {
   };
   HandTargetState target;
   // past the script's end the hand holds its last target still
-  const double t_end_s = config_.number("duration_s");
+  const double t_end_s = duration_s_;
   target_at(std::min(t_s, t_end_s), &target.p_m, &target.R);
   // the target's velocity by a forward difference over a small interval
   const double dt = 1e-5;
@@ -303,7 +304,7 @@ void ClosedLoop::tick(TraceRow* row) {
   const double t = time_s();
   row->t_s = t;
   set_hand_target(t);
-  const double t_script = std::min(t, config_.number("duration_s"));
+  const double t_script = std::min(t, duration_s_);
   row->segment = script_->segment_at(t_script);
   row->hand_target = script_->at(t_script);
 

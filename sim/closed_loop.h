@@ -168,6 +168,7 @@ class ClosedLoop {
   Mat3 R_start_base_ = Mat3::Identity();  // stylus frame at the start pose
   int substeps_ = 1;
   int ticks_per_run_ = 0;
+  double duration_s_ = 0.0;  // the script's, read once (the tick reads it)
   long tick_count_ = 0;
   // servo jitter: steps per tick drawn from [lo, hi]; the generator's state
   bool jitter_ = false;
