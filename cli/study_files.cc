@@ -6,6 +6,7 @@
 
 #include "cli/args.h"
 #include "sim/mujoco_util.h"
+#include "sim/output_file.h"
 #include "sim/run_case.h"
 
 namespace vmh::cli {
@@ -46,15 +47,7 @@ std::string write_study_file(const std::string& dir, const std::string& name,
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error(dir + ": " + ec.message());
   const fs::path path = fs::path(dir) / name;
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error(tmp.string() + ": cannot open for writing");
-    out << text;
-    if (!out) throw std::runtime_error(tmp.string() + ": write failed");
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) throw std::runtime_error(path.string() + ": " + ec.message());
+  sim::write_file_atomically(path.string(), text);
   return path.string();
 }
 

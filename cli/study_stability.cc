@@ -29,6 +29,7 @@
 #include "cli/args.h"
 #include "cli/json_util.h"
 #include "cli/study.h"
+#include "sim/output_file.h"
 #include "sim/run_case.h"
 #include "sim/stability_study.h"
 #include "sim/svg_chart.h"
@@ -67,14 +68,7 @@ constexpr int kDefaultStepsPerTick = 1000;
 constexpr double kDefaultMapBMaxTimesMOverT = 0.1;
 
 void write_file(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error(tmp.string() + ": cannot open for writing");
-    out << text;
-    if (!out) throw std::runtime_error(tmp.string() + ": write failed");
-  }
-  fs::rename(tmp, path);
+  sim::write_file_atomically(path.string(), text);
 }
 
 void make_out_dir(const std::string& out) {

@@ -13,6 +13,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "sim/output_file.h"
 #include "sim/run_case.h"
 
 namespace vmh::sim {
@@ -402,18 +403,6 @@ ExtremeResult run_extreme(const ExtremeScenario& s,
 namespace vmh::sim {
 namespace {
 
-void write_atomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw SimError(tmp.string() + ": cannot open for writing");
-    out << text;
-    if (!out) throw SimError(tmp.string() + ": write failed");
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw SimError(path.string() + ": " + ec.message());
-}
 
 std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
@@ -710,8 +699,8 @@ nlohmann::json run_extremes_study(const std::vector<std::string>& only,
           energy_J[i].push_back(rows[k].energy_motor_J);
         }
         if (!out_dir.empty()) {
-          write_atomically(fs::path(out_dir) / "extremes" / (table[i].name + ".csv"),
-                           series_csv(rows));
+          write_file_atomically((fs::path(out_dir) / "extremes" / (table[i].name + ".csv")).string(),
+series_csv(rows));
         }
       } catch (const std::exception& e) {
         errors[i] = table[i].name + ": " + e.what();
@@ -750,10 +739,10 @@ nlohmann::json run_extremes_study(const std::vector<std::string>& only,
       {"wall_time_s", wall},
   };
   if (!out_dir.empty()) {
-    write_atomically(fs::path(out_dir) / "extremes.csv", extremes_csv(*results));
-    write_atomically(fs::path(out_dir) / "extremes.json", j.dump(2) + "\n");
-    write_atomically(fs::path(out_dir) / "extremes.svg",
-                     energy_panels_svg(*results, energy_t, energy_J));
+    write_file_atomically((fs::path(out_dir) / "extremes.csv").string(), extremes_csv(*results));
+    write_file_atomically((fs::path(out_dir) / "extremes.json").string(), j.dump(2) + "\n");
+    write_file_atomically((fs::path(out_dir) / "extremes.svg").string(),
+energy_panels_svg(*results, energy_t, energy_J));
   }
   return j;
 }

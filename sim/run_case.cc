@@ -10,25 +10,13 @@
 #include <thread>
 
 #include "controller/device_frame.h"
+#include "sim/output_file.h"
 #include "sim/plot_svg.h"
 
 namespace vmh::sim {
 namespace fs = std::filesystem;
 namespace {
 
-// writes `text` to path via a temporary file and a rename
-void write_atomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw SimError(tmp.string() + ": cannot open for writing");
-    out << text;
-    if (!out) throw SimError(tmp.string() + ": write failed");
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw SimError(path.string() + ": " + ec.message());
-}
 
 void put(std::string* s, double x) {
   char buf[32];
@@ -242,10 +230,10 @@ CaseResult run_case(const std::string& name, const std::string& scene,
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) throw SimError(dir.string() + ": " + ec.message());
-    write_atomically(dir / "trace.csv", trace_csv(rows, loop));
-    write_atomically(dir / "summary.json", result.summary.dump(2) + "\n");
-    write_atomically(dir / "views.svg", views_svg(rows, loop));
-    write_atomically(dir / "history.svg", history_svg(rows, loop));
+    write_file_atomically((dir / "trace.csv").string(), trace_csv(rows, loop));
+    write_file_atomically((dir / "summary.json").string(), result.summary.dump(2) + "\n");
+    write_file_atomically((dir / "views.svg").string(), views_svg(rows, loop));
+    write_file_atomically((dir / "history.svg").string(), history_svg(rows, loop));
   }
   return result;
 }

@@ -10,24 +10,17 @@
 #include <utility>
 #include <vector>
 
+#include "sim/svg_text.h"
+
 namespace vmh::sim {
 namespace {
 
+using svg::attr;
+using svg::escape;
+using svg::format;
+using svg::px;
+
 // ---------------------------------------------------------------- text
-
-std::string format(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-
-// a pixel coordinate, two decimals
-std::string px(double v) {
-  if (!std::isfinite(v)) v = 0.0;
-  std::string s = format("%.2f", v);
-  if (s == "-0.00") s = "0.00";
-  return s;
-}
 
 // a number a reader reads (tick labels): plain from 0.001 to 1e7
 // ("150000", not "1.5e+05"), else in e-notation
@@ -36,27 +29,6 @@ std::string num(double v) {
   std::string s = format(a == 0.0 || (a >= 1e-3 && a < 1e7) ? "%.7g" : "%.4g", v);
   if (s == "-0") s = "0";
   return s;
-}
-
-std::string escape(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
-// ` name="value"`, the value escaped
-std::string attr(const char* name, const std::string& value) {
-  return std::string(" ") + name + "=\"" + escape(value) + "\"";
 }
 
 // Tableau 10: distinct on white, and in the usual order of matplotlib

@@ -1,0 +1,52 @@
+// Text helpers shared by the SVG writers (plot_svg.cc, svg_chart.cc):
+// numbers as SVG wants them and XML escaping.
+#ifndef VMHAPTICS_SIM_SVG_TEXT_H_
+#define VMHAPTICS_SIM_SVG_TEXT_H_
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace vmh::sim::svg {
+
+// one number through printf's format f
+inline std::string format(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+// a pixel coordinate: two decimals, far below what a screen shows; a
+// non-finite value is drawn at 0 rather than breaking the document
+inline std::string px(double v) {
+  if (!std::isfinite(v)) v = 0.0;
+  std::string s = format("%.2f", v);
+  if (s == "-0.00") s = "0.00";
+  return s;
+}
+
+// text escaped for XML content and attribute values
+inline std::string escape(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// ` name="value"`, the value escaped
+inline std::string attr(const char* name, const std::string& value) {
+  return std::string(" ") + name + "=\"" + escape(value) + "\"";
+}
+
+}  // namespace vmh::sim::svg
+
+#endif  // VMHAPTICS_SIM_SVG_TEXT_H_
