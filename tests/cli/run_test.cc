@@ -14,20 +14,13 @@
 namespace {
 
 namespace fs = std::filesystem;
+using vmh::testing::first_line;
 using vmh::testing::run;
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::path(::testing::TempDir()) / ("vmh_run_" + name);
-  fs::remove_all(d);
-  return d;
+  return vmh::testing::fresh_dir("vmh_run_", name);
 }
 
-std::string first_line(const fs::path& p) {
-  std::ifstream in(p);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
 
 TEST(RunCli, WritesTraceAndSummary) {
   const fs::path out = fresh_dir("case1");

@@ -12,14 +12,9 @@
 namespace {
 
 namespace fs = std::filesystem;
+using vmh::testing::first_line;
 using vmh::testing::run;
 
-std::string first_line(const fs::path& p) {
-  std::ifstream in(p);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
 
 TEST(StudyExtremesCli, WritesTablesAndPrintsJson) {
   const fs::path out = fs::path(::testing::TempDir()) / "vmh_study_extremes";

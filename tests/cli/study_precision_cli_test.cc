@@ -13,20 +13,13 @@
 namespace {
 
 namespace fs = std::filesystem;
+using vmh::testing::first_line;
 using vmh::testing::run;
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::path(::testing::TempDir()) / ("vmh_study_" + name);
-  fs::remove_all(d);
-  return d;
+  return vmh::testing::fresh_dir("vmh_study_", name);
 }
 
-std::string first_line(const fs::path& p) {
-  std::ifstream in(p);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
 
 // a precision study small enough for a test: 0.2 s of the script
 // compressed into 2 s, two rungs, a coarse reference

@@ -17,9 +17,7 @@ namespace fs = std::filesystem;
 using vmh::testing::run;
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::path(::testing::TempDir()) / ("vmh_stability_" + name);
-  fs::remove_all(d);
-  return d;
+  return vmh::testing::fresh_dir("vmh_stability_", name);
 }
 
 std::string read(const fs::path& p) {

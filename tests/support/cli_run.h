@@ -9,6 +9,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -44,6 +45,24 @@ inline CliRun run(const std::string& args) {
   r.err = ss.str();
   std::remove(err_path.c_str());
   return r;
+}
+
+// an empty path under the test temp directory, named `prefix` + `name`
+// (removed first if an earlier run left it)
+inline std::filesystem::path fresh_dir(const std::string& prefix,
+                                       const std::string& name) {
+  const std::filesystem::path d =
+      std::filesystem::path(::testing::TempDir()) / (prefix + name);
+  std::filesystem::remove_all(d);
+  return d;
+}
+
+// the first line of a text file ("" if it cannot be read)
+inline std::string first_line(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::string line;
+  std::getline(in, line);
+  return line;
 }
 
 }  // namespace vmh::testing
