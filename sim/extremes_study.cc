@@ -692,11 +692,23 @@ nlohmann::json run_extremes_study(const std::vector<std::string>& only,
     for (std::size_t i = next++; i < table.size(); i = next++) {
       try {
         (*results)[i] = run_extreme(table[i], &rows);
-        // the observer, thinned to about 400 points, for the figure
+        // the observer, thinned for the figure to about 400 buckets, each
+        // drawn by its lowest and highest point in time order, so that no
+        // peak or dip is lost to the thinning (the table's max and min are
+        // the curve's)
         const std::size_t stride = std::max<std::size_t>(1, rows.size() / 400);
-        for (std::size_t k = 0; k < rows.size(); k += stride) {
-          energy_t[i].push_back(rows[k].t_s);
-          energy_J[i].push_back(rows[k].energy_motor_J);
+        for (std::size_t k0 = 0; k0 < rows.size(); k0 += stride) {
+          const std::size_t k1 = std::min(rows.size(), k0 + stride);
+          std::size_t lo = k0, hi = k0;
+          for (std::size_t k = k0; k < k1; ++k) {
+            if (rows[k].energy_motor_J < rows[lo].energy_motor_J) lo = k;
+            if (rows[k].energy_motor_J > rows[hi].energy_motor_J) hi = k;
+          }
+          for (std::size_t k : {std::min(lo, hi), std::max(lo, hi)}) {
+            if (k == std::max(lo, hi) && lo == hi) break;
+            energy_t[i].push_back(rows[k].t_s);
+            energy_J[i].push_back(rows[k].energy_motor_J);
+          }
         }
         if (!out_dir.empty()) {
           write_file_atomically((fs::path(out_dir) / "extremes" / (table[i].name + ".csv")).string(),
