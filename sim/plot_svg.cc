@@ -18,6 +18,7 @@ namespace {
 using svg::attr;
 using svg::escape;
 using svg::format;
+using svg::nice_step;
 using svg::px;
 
 using Pt = std::pair<double, double>;
@@ -121,17 +122,6 @@ struct Bounds {
   }
   bool empty() const { return !(lo <= hi); }
 };
-
-// 1, 2, 2.5 or 5 x 10^k, the smallest giving at most about `ticks` steps
-double nice_step(double span, double ticks) {
-  if (!(span > 0.0) || !std::isfinite(span)) return 1.0;
-  const double raw = span / ticks;
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 2.5, 5.0}) {
-    if (m * mag >= raw * (1.0 - 1e-9)) return m * mag;
-  }
-  return 10.0 * mag;
-}
 
 long step_index_up(double v, double step) {
   return static_cast<long>(std::ceil(v / step - 1e-9));

@@ -1,5 +1,5 @@
-// Text helpers shared by the SVG writers (plot_svg.cc, svg_chart.cc):
-// numbers as SVG wants them and XML escaping.
+// Helpers shared by the SVG writers (plot_svg.cc, svg_chart.cc): numbers as
+// SVG wants them, XML escaping, and the step between an axis's ticks.
 #ifndef VMHAPTICS_SIM_SVG_TEXT_H_
 #define VMHAPTICS_SIM_SVG_TEXT_H_
 
@@ -45,6 +45,17 @@ inline std::string escape(const std::string& s) {
 // ` name="value"`, the value escaped
 inline std::string attr(const char* name, const std::string& value) {
   return std::string(" ") + name + "=\"" + escape(value) + "\"";
+}
+
+// 1, 2, 2.5 or 5 x 10^k, the smallest giving at most about `ticks` steps
+inline double nice_step(double span, double ticks) {
+  if (!(span > 0.0) || !std::isfinite(span)) return 1.0;
+  const double raw = span / ticks;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 2.5, 5.0}) {
+    if (m * mag >= raw * (1.0 - 1e-9)) return m * mag;
+  }
+  return 10.0 * mag;
 }
 
 }  // namespace vmh::sim::svg
