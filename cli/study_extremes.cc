@@ -14,12 +14,12 @@
 #include <iostream>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "cli/args.h"
 #include "cli/study.h"
 #include "sim/extremes_study.h"
+#include "sim/parallel.h"
 
 namespace vmh::cli {
 namespace {
@@ -57,8 +57,8 @@ void run(const ExtremesOptions& o) {
   std::vector<sim::ExtremeResult> results;
   nlohmann::json j;
   try {
-    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    j = sim::run_extremes_study(o.only, o.out, o.jobs > 0 ? o.jobs : cores, &results);
+    j = sim::run_extremes_study(o.only, o.out,
+                                o.jobs > 0 ? o.jobs : sim::core_count(), &results);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study extremes: ") + e.what());
   }

@@ -23,13 +23,13 @@
 #include <iostream>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "cli/args.h"
 #include "cli/json_util.h"
 #include "cli/study.h"
 #include "sim/output_file.h"
+#include "sim/parallel.h"
 #include "sim/run_case.h"
 #include "sim/stability_study.h"
 #include "sim/svg_chart.h"
@@ -267,9 +267,7 @@ void run_map(const StabilityOptions& o, const sim::StabilityParams& base) {
   sim::MapSpec spec;
   spec.base = base;
   spec.rel_tol = o.tolerance;
-  spec.jobs = o.jobs > 0 ? o.jobs
-                         : static_cast<int>(std::max(
-                               1u, std::thread::hardware_concurrency()));
+  spec.jobs = o.jobs > 0 ? o.jobs : sim::core_count();
   // with b = 0 the sweep starts one step above B = 0, where nothing is
   // stable
   const int first = base.damping_Ns_per_m > 0.0 ? 0 : 1;

@@ -1,7 +1,6 @@
 #include "sim/extremes_study.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -9,11 +8,11 @@
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "sim/output_file.h"
+#include "sim/parallel.h"
 #include "sim/run_case.h"
 
 namespace vmh::sim {
@@ -685,46 +684,38 @@ nlohmann::json run_extremes_study(const std::vector<std::string>& only,
   results->assign(table.size(), ExtremeResult{});
   std::vector<std::vector<double>> energy_t(table.size()), energy_J(table.size());
   std::vector<std::string> errors(table.size());
-  std::atomic<std::size_t> next{0};
   const auto start = std::chrono::steady_clock::now();
-  auto worker = [&] {
+  parallel_for(table.size(), jobs, [&](std::size_t i) {
     std::vector<TraceRow> rows;
-    for (std::size_t i = next++; i < table.size(); i = next++) {
-      try {
-        (*results)[i] = run_extreme(table[i], &rows);
-        // the observer, thinned for the figure to about 400 buckets, each
-        // drawn by its lowest and highest point in time order, so that no
-        // peak or dip is lost to the thinning (the table's max and min are
-        // the curve's)
-        const std::size_t stride = std::max<std::size_t>(1, rows.size() / 400);
-        for (std::size_t k0 = 0; k0 < rows.size(); k0 += stride) {
-          const std::size_t k1 = std::min(rows.size(), k0 + stride);
-          std::size_t lo = k0, hi = k0;
-          for (std::size_t k = k0; k < k1; ++k) {
-            if (rows[k].energy_motor_J < rows[lo].energy_motor_J) lo = k;
-            if (rows[k].energy_motor_J > rows[hi].energy_motor_J) hi = k;
-          }
-          for (std::size_t k : {std::min(lo, hi), std::max(lo, hi)}) {
-            if (k == std::max(lo, hi) && lo == hi) break;
-            energy_t[i].push_back(rows[k].t_s);
-            energy_J[i].push_back(rows[k].energy_motor_J);
-          }
+    try {
+      (*results)[i] = run_extreme(table[i], &rows);
+      // the observer, thinned for the figure to about 400 buckets, each
+      // drawn by its lowest and highest point in time order, so that no
+      // peak or dip is lost to the thinning (the table's max and min are
+      // the curve's)
+      const std::size_t stride = std::max<std::size_t>(1, rows.size() / 400);
+      for (std::size_t k0 = 0; k0 < rows.size(); k0 += stride) {
+        const std::size_t k1 = std::min(rows.size(), k0 + stride);
+        std::size_t lo = k0, hi = k0;
+        for (std::size_t k = k0; k < k1; ++k) {
+          if (rows[k].energy_motor_J < rows[lo].energy_motor_J) lo = k;
+          if (rows[k].energy_motor_J > rows[hi].energy_motor_J) hi = k;
         }
-        if (!out_dir.empty()) {
-          write_file_atomically((fs::path(out_dir) / "extremes" / (table[i].name + ".csv")).string(),
-series_csv(rows));
+        for (std::size_t k : {std::min(lo, hi), std::max(lo, hi)}) {
+          if (k == std::max(lo, hi) && lo == hi) break;
+          energy_t[i].push_back(rows[k].t_s);
+          energy_J[i].push_back(rows[k].energy_motor_J);
         }
-      } catch (const std::exception& e) {
-        errors[i] = table[i].name + ": " + e.what();
       }
+      if (!out_dir.empty()) {
+        write_file_atomically(
+            (fs::path(out_dir) / "extremes" / (table[i].name + ".csv")).string(),
+            series_csv(rows));
+      }
+    } catch (const std::exception& e) {
+      errors[i] = table[i].name + ": " + e.what();
     }
-  };
-  const std::size_t n_threads =
-      std::min<std::size_t>(table.size(), static_cast<std::size_t>(std::max(1, jobs)));
-  std::vector<std::thread> threads;
-  for (std::size_t t = 1; t < n_threads; ++t) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
+  });
   for (const std::string& e : errors) {
     if (!e.empty()) throw SimError(e);
   }

@@ -1,16 +1,15 @@
 #include "sim/run_case.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <thread>
 
 #include "controller/device_frame.h"
 #include "sim/output_file.h"
+#include "sim/parallel.h"
 #include "sim/plot_svg.h"
 
 namespace vmh::sim {
@@ -241,27 +240,18 @@ CaseResult run_case(const std::string& name, const std::string& scene,
 void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
                const std::string& out_dir, int threads) {
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    for (std::size_t i = next++; i < jobs->size(); i = next++) {
-      CaseJob& job = (*jobs)[i];
-      try {
-        job.result = run_case(job.name, job.scene, overrides, out_dir);
-      } catch (const SimError& e) {
-        job.error = e.what();
-        job.bad_input = true;
-      } catch (const std::exception& e) {
-        job.error = e.what();
-      }
-    }
-  };
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t n_threads = std::min<std::size_t>(
-      jobs->size(), threads > 0 ? static_cast<std::size_t>(threads) : cores);
-  std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < n_threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
+  parallel_for(jobs->size(), threads > 0 ? threads : core_count(),
+               [&](std::size_t i) {
+                 CaseJob& job = (*jobs)[i];
+                 try {
+                   job.result = run_case(job.name, job.scene, overrides, out_dir);
+                 } catch (const SimError& e) {
+                   job.error = e.what();
+                   job.bad_input = true;
+                 } catch (const std::exception& e) {
+                   job.error = e.what();
+                 }
+               });
 }
 
 }  // namespace vmh::sim

@@ -2,7 +2,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -10,8 +9,8 @@
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
+#include "sim/parallel.h"
 #include "sim/svg_chart.h"
 
 namespace vmh::sim {
@@ -477,35 +476,26 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
       points.push_back(pt);
     }
   }
-  std::atomic<std::size_t> next{0};
   std::vector<std::exception_ptr> errors(points.size());
-  auto worker = [&] {
-    for (std::size_t i = next++; i < points.size(); i = next++) {
-      try {
-        const StabilityParams& p = params[i];
-        MapPoint& pt = points[i];
-        pt.k_bound_gil_N_per_m = k_bound_gil_N_per_m(p);
-        pt.k_passivity_N_per_m = k_passivity_N_per_m(p);
-        pt.k_crit_exact_N_per_m =
-            k_crit_discrete(p, PlantModel::kExactZoh).k_crit_N_per_m;
-        pt.k_crit_mujoco_euler_N_per_m =
-            k_crit_discrete(p, PlantModel::kMujocoEuler).k_crit_N_per_m;
-        SliderWall wall(model_path, p);
-        const double guess = pt.k_crit_exact_N_per_m > 0.0
-                                 ? pt.k_crit_exact_N_per_m
-                                 : pt.k_bound_gil_N_per_m;
-        pt.sim = k_crit_simulated(wall, guess, spec.rel_tol);
-      } catch (...) {
-        errors[i] = std::current_exception();
-      }
+  parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
+    try {
+      const StabilityParams& p = params[i];
+      MapPoint& pt = points[i];
+      pt.k_bound_gil_N_per_m = k_bound_gil_N_per_m(p);
+      pt.k_passivity_N_per_m = k_passivity_N_per_m(p);
+      pt.k_crit_exact_N_per_m =
+          k_crit_discrete(p, PlantModel::kExactZoh).k_crit_N_per_m;
+      pt.k_crit_mujoco_euler_N_per_m =
+          k_crit_discrete(p, PlantModel::kMujocoEuler).k_crit_N_per_m;
+      SliderWall wall(model_path, p);
+      const double guess = pt.k_crit_exact_N_per_m > 0.0
+                               ? pt.k_crit_exact_N_per_m
+                               : pt.k_bound_gil_N_per_m;
+      pt.sim = k_crit_simulated(wall, guess, spec.rel_tol);
+    } catch (...) {
+      errors[i] = std::current_exception();
     }
-  };
-  const std::size_t n_threads = std::clamp<std::size_t>(
-      static_cast<std::size_t>(std::max(spec.jobs, 1)), 1, points.size());
-  std::vector<std::thread> threads;
-  for (std::size_t t = 1; t < n_threads; ++t) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
+  });
   for (const std::exception_ptr& e : errors) {
     if (e) std::rethrow_exception(e);
   }
