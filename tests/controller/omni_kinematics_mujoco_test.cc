@@ -27,6 +27,7 @@
 #include "controller/omni_kinematics.h"
 #include "controller/omni_params.h"
 #include "controller/types.h"
+#include "tests/support/mujoco_kinematics.h"
 
 namespace vmh {
 namespace {
@@ -36,8 +37,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kTol = 1e-9;
 constexpr int kConfigs = 2000;
 
-using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-using RowJac = Eigen::Matrix<double, 3, kOmniJoints, Eigen::RowMajor>;
+using testing::max_abs_diff;
 
 // -- mujoco error capture --
 
@@ -176,12 +176,6 @@ ModelPtr load_mjcf(const std::string& xml, std::string* error) {
 
 // -- comparison helpers --
 
-template <typename A, typename B>
-double max_abs_diff(const Eigen::MatrixBase<A>& a,
-                    const Eigen::MatrixBase<B>& b) {
-  return (a - b).cwiseAbs().maxCoeff();
-}
-
 Joints random_joints(std::mt19937_64* rng) {
   std::uniform_real_distribution<double> angle(-kPi, kPi);
   Joints q;
@@ -226,22 +220,14 @@ class OmniMujocoTest : public ::testing::Test {
     EXPECT_TRUE(mujoco_messages().empty()) << MujocoMessageGuard::joined();
   }
 
-  // sets qpos and runs the position stages mj_jacSite depends on
   void set_q(const Joints& q) {
-    for (int i = 0; i < kOmniJoints; ++i) data_->qpos[i] = q[i];
-    mj_kinematics(model_.get(), data_.get());
-    mj_comPos(model_.get(), data_.get());
+    testing::set_joints(model_.get(), data_.get(), q);
   }
-
-  Vec3 site_pos(int site) const {
-    return Eigen::Map<const Vec3>(data_->site_xpos + 3 * site);
-  }
-  Mat3 site_rot(int site) const {
-    return Eigen::Map<const RowMat3>(data_->site_xmat + 9 * site);
-  }
-  // mj_jacSite: 3 x nv row-major, linear and angular parts
-  void site_jac(int site, RowJac* jacp, RowJac* jacr) const {
-    mj_jacSite(model_.get(), data_.get(), jacp->data(), jacr->data(), site);
+  Vec3 site_pos(int site) const { return testing::site_pos(data_.get(), site); }
+  Mat3 site_rot(int site) const { return testing::site_rot(data_.get(), site); }
+  // mj_jacSite: linear rows over angular rows
+  Mat6 site_jac(int site) const {
+    return testing::site_jacobian(model_.get(), data_.get(), site);
   }
 
   // checks every identity at kConfigs random configurations and returns the
@@ -250,20 +236,14 @@ class OmniMujocoTest : public ::testing::Test {
     std::mt19937_64 rng(seed);
     MaxErrors e;
     OmniFrames frames;
-    RowJac jacp, jacr;
     for (int k = 0; k < kConfigs; ++k) {
       const Joints q = random_joints(&rng);
       set_q(q);
 
       // frame of body i (xpos, xmat) == T_{0,i} of omni_frames, i = 1..6
       omni_frames(params_, q, &frames);
-      for (int b = 1; b <= kOmniJoints; ++b) {
-        const Vec3 p = Eigen::Map<const Vec3>(data_->xpos + 3 * b);
-        const Mat3 R = Eigen::Map<const RowMat3>(data_->xmat + 9 * b);
-        e.frames =
-            std::max({e.frames, max_abs_diff(p, frames.T_base[b].translation()),
-                      max_abs_diff(R, frames.T_base[b].linear())});
-      }
+      e.frames =
+          std::max(e.frames, testing::max_body_frame_error(data_.get(), frames));
 
       // wrist site: site_xpos == omni_fk.p_base_m, site_xmat == R_base
       const OmniPose pose = omni_fk(params_, q);
@@ -274,9 +254,11 @@ class OmniMujocoTest : public ::testing::Test {
 
       // wrist jacobian: jacp == J.rows(0..2), jacr == J.rows(3..5)
       const Mat6 J = omni_jacobian(params_, q);
-      site_jac(wrist_, &jacp, &jacr);
-      e.jac_lin = std::max(e.jac_lin, max_abs_diff(jacp, J.topRows<3>()));
-      e.jac_ang = std::max(e.jac_ang, max_abs_diff(jacr, J.bottomRows<3>()));
+      const Mat6 Jm = site_jac(wrist_);
+      e.jac_lin = std::max(e.jac_lin,
+                           max_abs_diff(Jm.topRows<3>(), J.topRows<3>()));
+      e.jac_ang = std::max(e.jac_ang,
+                           max_abs_diff(Jm.bottomRows<3>(), J.bottomRows<3>()));
 
       // tool site: site_xpos == omni_tool_point(omni_fk), and mj_jacSite ==
       // omni_jacobian_at(q, tool_offset_m)
@@ -284,11 +266,11 @@ class OmniMujocoTest : public ::testing::Test {
           e.tool_pos,
           max_abs_diff(site_pos(tool_), omni_tool_point(params_, pose)));
       const Mat6 Jt = omni_jacobian_at(params_, q, params_.tool_offset_m);
-      site_jac(tool_, &jacp, &jacr);
-      e.tool_jac_lin =
-          std::max(e.tool_jac_lin, max_abs_diff(jacp, Jt.topRows<3>()));
-      e.tool_jac_ang =
-          std::max(e.tool_jac_ang, max_abs_diff(jacr, Jt.bottomRows<3>()));
+      const Mat6 Jtm = site_jac(tool_);
+      e.tool_jac_lin = std::max(
+          e.tool_jac_lin, max_abs_diff(Jtm.topRows<3>(), Jt.topRows<3>()));
+      e.tool_jac_ang = std::max(
+          e.tool_jac_ang, max_abs_diff(Jtm.bottomRows<3>(), Jt.bottomRows<3>()));
     }
     return e;
   }

@@ -25,6 +25,7 @@
 #include "controller/types.h"
 #include "tests/models/model_files.h"
 #include "tests/support/mujoco_guard.h"
+#include "tests/support/mujoco_kinematics.h"
 #include "tests/support/random_joints.h"
 
 namespace vmh {
@@ -33,8 +34,8 @@ namespace {
 using testing::DataPtr;
 using testing::ModelPtr;
 using testing::MujocoGuard;
-using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-using RowJac = Eigen::Matrix<double, 3, kOmniJoints, Eigen::RowMajor>;
+using testing::max_abs_diff;
+using testing::RowJac;
 using RowMat6 = Eigen::Matrix<double, kOmniJoints, kOmniJoints, Eigen::RowMajor>;
 
 constexpr double kPi = 3.14159265358979323846;
@@ -59,12 +60,6 @@ constexpr std::array<BodyEstimate, kOmniJoints> kBodies = {{
 // README.md: "moving mass 0.370 kg"
 constexpr double kMovingMassKg = 0.370;
 
-template <typename A, typename B>
-double max_abs_diff(const Eigen::MatrixBase<A>& a,
-                    const Eigen::MatrixBase<B>& b) {
-  return (a - b).cwiseAbs().maxCoeff();
-}
-
 class OmniModelTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -82,27 +77,13 @@ class OmniModelTest : public ::testing::Test {
     return mj_name2id(model_.get(), type, name);
   }
 
-  // puts q into qpos and updates positions, frames and the com-based
-  // quantities mj_jacSite needs (REFERENCE.md §7)
   void set_q(const Joints& q) {
-    for (int i = 0; i < kOmniJoints; ++i) data_->qpos[i] = q[i];
-    mj_kinematics(model_.get(), data_.get());
-    mj_comPos(model_.get(), data_.get());
+    testing::set_joints(model_.get(), data_.get(), q);
   }
-
-  Vec3 site_pos(int s) const {
-    return Eigen::Map<const Vec3>(data_->site_xpos + 3 * s);
-  }
-  Mat3 site_rot(int s) const {
-    return Eigen::Map<const RowMat3>(data_->site_xmat + 9 * s);
-  }
+  Vec3 site_pos(int s) const { return testing::site_pos(data_.get(), s); }
+  Mat3 site_rot(int s) const { return testing::site_rot(data_.get(), s); }
   Mat6 site_jac(int s) const {
-    RowJac jacp, jacr;
-    mj_jacSite(model_.get(), data_.get(), jacp.data(), jacr.data(), s);
-    Mat6 J;
-    J.topRows<3>() = jacp;
-    J.bottomRows<3>() = jacr;
-    return J;
+    return testing::site_jacobian(model_.get(), data_.get(), s);
   }
 
   MujocoGuard guard_;
@@ -235,13 +216,7 @@ TEST_F(OmniModelTest, SitesMatchControllerKinematics) {
     set_q(q);
 
     omni_frames(params_, q, &frames);
-    for (int b = 1; b <= kOmniJoints; ++b) {
-      const Vec3 p = Eigen::Map<const Vec3>(data_->xpos + 3 * b);
-      const Mat3 R = Eigen::Map<const RowMat3>(data_->xmat + 9 * b);
-      e.frames = std::max(
-          {e.frames, max_abs_diff(p, frames.T_base[b].translation()),
-           max_abs_diff(R, frames.T_base[b].linear())});
-    }
+    e.frames = std::max(e.frames, testing::max_body_frame_error(data_.get(), frames));
 
     const OmniPose pose = omni_fk(params_, q);
     e.wrist_pos =
