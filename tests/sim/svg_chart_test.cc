@@ -22,8 +22,13 @@
 #include <utility>
 #include <vector>
 
+#include "tests/support/svg_check.h"
+
 namespace vmh::sim {
 namespace {
+
+using vmh::testing::count;
+using vmh::testing::tag_problems;
 
 using Pt = std::pair<double, double>;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -34,46 +39,6 @@ void save(const std::string& name, const std::string& doc) {
   if (const char* dir = std::getenv("VMH_SVG_CHART_DIR")) {
     std::ofstream(std::string(dir) + "/" + name + ".svg") << doc;
   }
-}
-
-std::size_t count(const std::string& s, const std::string& what) {
-  std::size_t n = 0;
-  for (std::size_t p = s.find(what); p != std::string::npos;
-       p = s.find(what, p + 1)) {
-    ++n;
-  }
-  return n;
-}
-
-// "" when the tags nest under one <svg> root, quotes pair up inside tags and
-// text holds no raw '<' or '>'; else what is wrong
-std::string tag_problems(const std::string& s) {
-  std::vector<std::string> open;
-  bool root_done = false;
-  std::size_t i = 0;
-  while (true) {
-    const std::size_t lt = s.find('<', i);
-    const std::string text = s.substr(i, lt == std::string::npos ? std::string::npos : lt - i);
-    if (text.find('>') != std::string::npos) return "raw '>' in text";
-    if (lt == std::string::npos) break;
-    const std::size_t gt = s.find('>', lt);
-    if (gt == std::string::npos) return "unclosed '<'";
-    const std::string tag = s.substr(lt + 1, gt - lt - 1);
-    if (tag.empty() || tag.find('<') != std::string::npos) return "bad tag " + tag;
-    if (count(tag, "\"") % 2 != 0) return "unpaired quote in <" + tag + ">";
-    if (tag[0] == '/') {
-      if (open.empty() || open.back() != tag.substr(1)) return "misnested </" + tag;
-      open.pop_back();
-      if (open.empty()) root_done = true;
-    } else {
-      const std::string name = tag.substr(0, tag.find_first_of(" \n/"));
-      if (open.empty() && (root_done || name != "svg")) return "root is not one <svg>";
-      if (tag.back() != '/') open.push_back(name);
-    }
-    i = gt + 1;
-  }
-  if (!open.empty()) return "<" + open.back() + "> never closed";
-  return root_done ? "" : "no root";
 }
 
 // the attributes of the first element <name ... class="cls" ...>
