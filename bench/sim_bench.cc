@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "sim/closed_loop.h"
-#include "sim/run_case.h"
+#include "studies/run_case.h"
 
 namespace vmh::sim {
 namespace {

@@ -14,7 +14,7 @@
 #include <iostream>
 
 #include "cli/args.h"
-#include "sim/run_case.h"
+#include "studies/run_case.h"
 
 namespace vmh::cli {
 namespace {

@@ -18,8 +18,8 @@
 
 #include "cli/args.h"
 #include "cli/study.h"
-#include "sim/extremes_study.h"
-#include "sim/parallel.h"
+#include "studies/extremes_study.h"
+#include "report/parallel.h"
 
 namespace vmh::cli {
 namespace {

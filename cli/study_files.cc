@@ -6,8 +6,8 @@
 
 #include "cli/args.h"
 #include "sim/mujoco_util.h"
-#include "sim/output_file.h"
-#include "sim/run_case.h"
+#include "report/output_file.h"
+#include "studies/run_case.h"
 
 namespace vmh::cli {
 namespace fs = std::filesystem;

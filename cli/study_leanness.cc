@@ -14,9 +14,9 @@
 #include "cli/json_util.h"
 #include "cli/study.h"
 #include "cli/study_files.h"
-#include "sim/leanness_study.h"
+#include "studies/leanness_study.h"
 #include "sim/mujoco_util.h"
-#include "sim/run_case.h"
+#include "studies/run_case.h"
 
 namespace vmh::cli {
 namespace {

@@ -19,7 +19,7 @@
 #include "cli/study_files.h"
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
-#include "sim/precision_study.h"
+#include "studies/precision_study.h"
 
 namespace vmh::cli {
 namespace {

@@ -28,11 +28,11 @@
 #include "cli/args.h"
 #include "cli/json_util.h"
 #include "cli/study.h"
-#include "sim/output_file.h"
-#include "sim/parallel.h"
-#include "sim/run_case.h"
-#include "sim/stability_study.h"
-#include "sim/svg_chart.h"
+#include "report/output_file.h"
+#include "report/parallel.h"
+#include "studies/run_case.h"
+#include "studies/stability_study.h"
+#include "report/svg_chart.h"
 
 namespace vmh::cli {
 namespace {

@@ -37,8 +37,9 @@
 #include <vector>
 
 #include "controller/controller.h"
-#include "controller/haptic_device.h"
+#include "device/servo_tick.h"
 #include "sim/case_config.h"
+#include "device/reading_guard.h"
 #include "sim/fault_injector.h"
 #include "sim/hand.h"
 #include "sim/hand_script.h"

@@ -1,4 +1,4 @@
-// The MuJoCo Omni behind the device interface (controller/haptic_device.h),
+// The MuJoCo Omni behind the device interface (device/haptic_device.h),
 // so that the servo loop cannot tell it from the real device.
 //
 // read_joints: the model's DH joint angles (joints "q1".."q6"), converted to
@@ -14,7 +14,7 @@
 #include <array>
 #include <string>
 
-#include "controller/haptic_device.h"
+#include "device/haptic_device.h"
 #include "controller/omni_params.h"
 #include "sim/sensor_model.h"
 

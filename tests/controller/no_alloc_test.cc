@@ -17,7 +17,7 @@
 
 #include "controller/controller.h"
 #include "controller/device_frame.h"
-#include "controller/haptic_device.h"
+#include "device/servo_tick.h"
 #include "controller/omni_kinematics.h"
 #include "tests/support/alloc_counter.h"
 #include "tests/support/eigen_assert_throws.h"

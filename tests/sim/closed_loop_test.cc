@@ -15,8 +15,8 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
-#include "sim/claims.h"
-#include "sim/run_case.h"
+#include "studies/claims.h"
+#include "studies/run_case.h"
 #include "tests/support/mujoco_guard.h"
 
 namespace vmh::sim {

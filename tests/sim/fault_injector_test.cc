@@ -1,7 +1,7 @@
 // sim/fault_injector.h on its own, against a scripted device: the injector
 // corrupts exactly the joint, from exactly the time, by exactly the amount
-// it says; the guard refuses what no hand can do and passes what one can;
-// neither allocates on the servo path.
+// it says, and allocates nothing on the servo path, behind the device
+// layer's guard (tested alone in tests/device/reading_guard_test.cc).
 #include "sim/fault_injector.h"
 
 #include <gtest/gtest.h>
@@ -9,40 +9,16 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "device/reading_guard.h"
 #include "tests/support/alloc_counter.h"
+#include "tests/support/scripted_device.h"
 
 namespace vmh::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kCount = 2.0 * kPi / 15000.0;  // one encoder count, rad
-
-// A device whose readings the test sets, and which records what it was told.
-class ScriptedDevice final : public HapticDevice {
- public:
-  Joints q = Joints::Zero();
-  DeviceError read_error = DeviceError::kOk;
-  Vec3 written = Vec3::Constant(-1.0);
-  int writes = 0;
-
-  DeviceError read_joints(Joints* out) noexcept override {
-    if (read_error != DeviceError::kOk) return read_error;
-    *out = q;
-    return DeviceError::kOk;
-  }
-  DeviceError write_motor_torques(const Vec3& tau) noexcept override {
-    written = tau;
-    ++writes;
-    return DeviceError::kOk;
-  }
-};
-
-Joints ramp(double t_s) {
-  // every joint moving at a plausible 1 rad/s, from different offsets
-  Joints q;
-  for (int i = 0; i < 6; ++i) q[i] = 0.1 * i + t_s;
-  return q;
-}
+using testing::kCount;
+using testing::ramp;
+using testing::ScriptedDevice;
 
 TEST(FaultInjector, NoneAndBeforeOnsetPassTheReadingThrough) {
   ScriptedDevice dev;
@@ -156,89 +132,6 @@ GuardParams guard_params() {
   p.max_speed_rad_s = 50.0;
   p.max_period_s = 1e-3;
   return p;
-}
-
-TEST(ReadingGuard, PassesWhatAHandCanDo) {
-  ScriptedDevice dev;
-  ReadingGuard guard(&dev, guard_params());
-  // 40 rad/s on every encoder, 1 ms apart: inside the 50 rad/s bound
-  for (int k = 0; k < 100; ++k) {
-    dev.q.setZero();
-    dev.q.head<3>().setConstant(0.04 * k);
-    Joints q;
-    ASSERT_EQ(guard.read_joints(&q), DeviceError::kOk) << "tick " << k;
-    EXPECT_EQ(q, dev.q);
-    EXPECT_EQ(guard.last_fault(), GuardFault::kNone);
-  }
-  EXPECT_NEAR(guard.max_step_rad(), 0.05, 1e-15);
-}
-
-TEST(ReadingGuard, NanIsRefusedWhileItLasts) {
-  ScriptedDevice dev;
-  ReadingGuard guard(&dev, guard_params());
-  Joints q;
-  dev.q = ramp(0.0);
-  ASSERT_EQ(guard.read_joints(&q), DeviceError::kOk);
-  dev.q[4] = std::nan("");
-  EXPECT_EQ(guard.read_joints(&q), DeviceError::kSensorFault);
-  EXPECT_EQ(guard.last_fault(), GuardFault::kNonFinite);
-  EXPECT_STREQ(guard_fault_name(guard.last_fault()), "sensor_nan");
-  EXPECT_FALSE(guard.latched());
-  // the reading recovers, far from the last good one: after a gap that is
-  // not a jump
-  dev.q = ramp(0.0);
-  dev.q[0] += 1.0;
-  EXPECT_EQ(guard.read_joints(&q), DeviceError::kOk);
-}
-
-TEST(ReadingGuard, AJumpLatchesUntilReset) {
-  ScriptedDevice dev;
-  ReadingGuard guard(&dev, guard_params());
-  Joints q;
-  dev.q = ramp(0.0);
-  ASSERT_EQ(guard.read_joints(&q), DeviceError::kOk);
-  dev.q[1] += 1000.0 * kCount;
-  EXPECT_EQ(guard.read_joints(&q), DeviceError::kSensorFault);
-  EXPECT_EQ(guard.last_fault(), GuardFault::kJump);
-  EXPECT_STREQ(guard_fault_name(guard.last_fault()), "sensor_jump");
-  // the angle is wrong for good: every later reading is refused
-  for (int k = 0; k < 10; ++k) {
-    EXPECT_EQ(guard.read_joints(&q), DeviceError::kSensorFault);
-    EXPECT_TRUE(guard.latched());
-  }
-  guard.reset();
-  EXPECT_EQ(guard.read_joints(&q), DeviceError::kOk);
-}
-
-TEST(ReadingGuard, ThresholdIsTheSpeedTimesTheLongestPeriod) {
-  ScriptedDevice dev;
-  GuardParams p = guard_params();
-  p.max_period_s = 2.8e-3;  // the jittered loop's longest period
-  ReadingGuard guard(&dev, p);
-  Joints q;
-  dev.q.setZero();
-  ASSERT_EQ(guard.read_joints(&q), DeviceError::kOk);
-  dev.q[2] = 0.99 * 50.0 * 2.8e-3;
-  EXPECT_EQ(guard.read_joints(&q), DeviceError::kOk);
-  dev.q[2] += 1.01 * 50.0 * 2.8e-3;
-  EXPECT_EQ(guard.read_joints(&q), DeviceError::kSensorFault);
-}
-
-TEST(ReadingGuard, GimbalAndDisabledAreNotChecked) {
-  ScriptedDevice dev;
-  ReadingGuard guard(&dev, guard_params());
-  Joints q;
-  dev.q.setZero();
-  ASSERT_EQ(guard.read_joints(&q), DeviceError::kOk);
-  dev.q[3] = 2.0;  // a potentiometer swings far: absolute, not checked
-  EXPECT_EQ(guard.read_joints(&q), DeviceError::kOk);
-
-  GuardParams off = guard_params();
-  off.enabled = false;
-  ReadingGuard open(&dev, off);
-  dev.q[0] = std::nan("");
-  EXPECT_EQ(open.read_joints(&q), DeviceError::kOk);
-  EXPECT_TRUE(std::isnan(q[0]));
 }
 
 // The servo path allocates nothing (the controller's own promise, extended

@@ -1,0 +1,17 @@
+#include "device/haptic_device.h"
+
+namespace vmh {
+
+const char* device_error_name(DeviceError e) {
+  switch (e) {
+    case DeviceError::kOk: return "ok";
+    case DeviceError::kNotConnected: return "not_connected";
+    case DeviceError::kIo: return "io";
+    case DeviceError::kTimeout: return "timeout";
+    case DeviceError::kSensorFault: return "sensor_fault";
+    case DeviceError::kInvalidCommand: return "invalid_command";
+  }
+  return "unknown";
+}
+
+}  // namespace vmh

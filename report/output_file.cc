@@ -1,0 +1,35 @@
+#include "report/output_file.h"
+
+#include <filesystem>
+#include <fstream>
+#include <system_error>
+
+#include <stdexcept>
+
+namespace vmh::sim {
+
+void write_file_atomically(const std::string& path, const std::string& text) {
+  namespace fs = std::filesystem;
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw std::runtime_error(tmp + ": cannot open for writing");
+    out << text;
+    out.flush();
+    if (!out) {
+      out.close();
+      std::error_code ignored;
+      fs::remove(tmp, ignored);
+      throw std::runtime_error(tmp + ": write failed");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw std::runtime_error(path + ": " + ec.message());
+  }
+}
+
+}  // namespace vmh::sim

@@ -1,0 +1,17 @@
+// Writing the testbed's outputs (traces, summaries, tables, plots) so that a
+// failed or interrupted write never leaves a half-written file behind.
+#ifndef VMHAPTICS_REPORT_OUTPUT_FILE_H_
+#define VMHAPTICS_REPORT_OUTPUT_FILE_H_
+
+#include <string>
+
+namespace vmh::sim {
+
+// Writes `text` to `path` through "<path>.tmp" and a rename (atomic on one
+// file system): readers see the old file or the whole new one. Throws
+// std::runtime_error naming the path when it cannot open, write or rename.
+void write_file_atomically(const std::string& path, const std::string& text);
+
+}  // namespace vmh::sim
+
+#endif  // VMHAPTICS_REPORT_OUTPUT_FILE_H_

@@ -1,0 +1,55 @@
+// A small x-y chart as a standalone SVG 1.1 document, for the numerical
+// studies (work-precision on log-log axes, stability maps with the theory's
+// line drawn over the simulated points). The standard library only.
+//
+// Each series is drawn as a polyline, markers, or both, in its own colour,
+// and named in a legend. Axes may be linear or logarithmic (base 10, with a
+// tick at each decade); a log axis drops points <= 0 and says how many it
+// dropped in a <desc> element. Non-finite points are dropped likewise.
+//
+// Elements a reader (or a test) can find: the chart is <svg class="chart">,
+// each series a <g class="series" id="series-N"> (N from 0, in order) holding
+// a <polyline> and/or <circle> markers whose coordinates are pixels, and
+// each axis label a <text class="axis-label">.
+#ifndef VMHAPTICS_REPORT_SVG_CHART_H_
+#define VMHAPTICS_REPORT_SVG_CHART_H_
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace vmh::sim {
+
+struct ChartSeries {
+  std::string label;        // legend text
+  std::vector<double> x;    // same length as y
+  std::vector<double> y;
+  std::string color;        // CSS colour; empty: the next of a fixed palette
+  bool line = true;         // a polyline through the points, in order
+  bool markers = true;      // a dot at each point
+  bool dashed = false;      // dashed polyline (e.g. a theoretical bound)
+};
+
+struct ChartAxis {
+  std::string label;        // with its unit, e.g. "wall time (s)"
+  bool log = false;         // base-10 logarithmic
+  double min = std::nan("");  // NaN: from the data (padded, or whole decades)
+  double max = std::nan("");
+};
+
+struct Chart {
+  std::string title;
+  ChartAxis x;
+  ChartAxis y;
+  std::vector<ChartSeries> series;
+  int width_px = 640;
+  int height_px = 420;
+};
+
+// The chart as an SVG document. Throws std::invalid_argument if a series has
+// x and y of different lengths.
+std::string chart_svg(const Chart& chart);
+
+}  // namespace vmh::sim
+
+#endif  // VMHAPTICS_REPORT_SVG_CHART_H_

@@ -1,0 +1,293 @@
+#include "studies/leanness_study.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <limits>
+#include <memory>
+
+#include <time.h>
+
+#include "controller/controller.h"
+#include "controller/device_frame.h"
+#include "controller/omni_kinematics.h"
+#include "sim/closed_loop.h"
+#include "sim/mujoco_util.h"
+
+namespace vmh::sim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// room for every geom of the Omni and the hand many times over; simulate's
+// default is 2000 for scenes far larger than these
+constexpr int kSceneMaxGeoms = 1000;
+
+// CPU time of the calling thread (s), POSIX clock_gettime
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+std::string exact(double x) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+// an mjvScene with its option and camera, freed with it
+class ViewerState {
+ public:
+  explicit ViewerState(const mjModel* m) {
+    mjv_defaultScene(&scene_);
+    mjv_defaultOption(&option_);
+    mjv_defaultCamera(&camera_);
+    mjv_makeScene(m, &scene_, kSceneMaxGeoms);
+  }
+  ~ViewerState() { mjv_freeScene(&scene_); }
+  ViewerState(const ViewerState&) = delete;
+  ViewerState& operator=(const ViewerState&) = delete;
+
+  void update(const mjModel* m, mjData* d) {
+    mjv_updateScene(m, d, &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
+  }
+  int geoms() const { return scene_.ngeom; }
+
+ private:
+  mjvScene scene_;
+  mjvOption option_;
+  mjvCamera camera_;
+};
+
+// One variant's loop, its model changed as the variant says.
+struct VariantLoop {
+  LeannessVariant variant;
+  std::unique_ptr<ClosedLoop> loop;
+  std::unique_ptr<ViewerState> viewer;
+  VariantResult result;
+  std::vector<Vec3> p_mm;       // wrist centre per tick, last repeat
+  std::vector<Joints> q_read;   // what the controller read, per tick
+};
+
+void switch_on(ClosedLoop* loop, unsigned ingredients) {
+  // ClosedLoop owns its model non-const (load_model returns an mjModel*)
+  // and hands it out read-only; the variants change only option flags,
+  // gravity and collision masks, none of which ClosedLoop caches, and then
+  // reset the loop so that mjData follows.
+  mjModel* m = const_cast<mjModel*>(loop->model());
+  if (ingredients & kContacts) {
+    m->opt.disableflags &= ~static_cast<int>(mjDSBL_CONTACT);
+    for (int g = 0; g < m->ngeom; ++g) {
+      m->geom_contype[g] = 1;
+      m->geom_conaffinity[g] = 1;
+    }
+  }
+  if (ingredients & kGravity) {
+    m->opt.disableflags &= ~static_cast<int>(mjDSBL_GRAVITY);
+    m->opt.gravity[0] = 0.0;
+    m->opt.gravity[1] = 0.0;
+    m->opt.gravity[2] = -9.81;
+  }
+  if (ingredients & kNoFrictionloss) {
+    m->opt.disableflags |= mjDSBL_FRICTIONLOSS;
+  }
+  loop->reset();
+}
+
+void run_variant(VariantLoop* v, int ticks) {
+  ClosedLoop& loop = *v->loop;
+  const mjModel* m = loop.model();
+  mjData* d = loop.data();
+  const OmniParams& omni = loop.controller_params().omni;
+  const std::size_t n = static_cast<std::size_t>(ticks);
+  v->p_mm.resize(n);
+  v->q_read.resize(n);
+  long ncon_sum = 0, nefc_sum = 0;
+  int ncon_max = 0, nefc_max = 0;
+
+  loop.reset();
+  TraceRow row;
+  const auto t0 = Clock::now();
+  const double cpu0 = thread_cpu_s();
+  for (std::size_t k = 0; k < n; ++k) {
+    loop.tick(&row);
+    if (v->viewer) v->viewer->update(m, d);
+    v->p_mm[k] =
+        base_to_device_mm(omni, omni_fk(omni, loop.device().true_q_dh()).p_base_m);
+    v->q_read[k] = row.q_dh;
+    ncon_sum += d->ncon;
+    nefc_sum += d->nefc;
+    ncon_max = std::max(ncon_max, d->ncon);
+    nefc_max = std::max(nefc_max, d->nefc);
+  }
+  const double cpu_s = thread_cpu_s() - cpu0;
+  const double wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+
+  VariantResult& r = v->result;
+  r.wall_time_s = std::min(r.wall_time_s, wall_s);
+  r.cpu_time_s = std::min(r.cpu_time_s, cpu_s);
+  const double nn = std::max<double>(1.0, static_cast<double>(n));
+  r.mean_ncon = static_cast<double>(ncon_sum) / nn;
+  r.max_ncon = ncon_max;
+  r.mean_nefc = static_cast<double>(nefc_sum) / nn;
+  r.max_nefc = nefc_max;
+  r.scene_geoms = v->viewer ? v->viewer->geoms() : 0;
+  if (v->viewer) {
+    // the update alone, as many times as the run had ticks, from where the
+    // run ended (clocking each call inside the run would cost as much as
+    // the call)
+    const double c0 = thread_cpu_s();
+    for (std::size_t k = 0; k < n; ++k) v->viewer->update(m, d);
+    const double us = 1e6 * (thread_cpu_s() - c0) / nn;
+    r.render_us_per_tick =
+        r.render_us_per_tick > 0.0 ? std::min(r.render_us_per_tick, us) : us;
+  }
+  int warnings = 0;
+  for (int i = 0; i < mjNWARNING; ++i) warnings += d->warning[i].number;
+  r.mujoco_warnings = warnings;
+}
+
+}  // namespace
+
+const std::vector<LeannessVariant>& leanness_variants() {
+  static const std::vector<LeannessVariant> variants = {
+      {"composed", 0u},
+      {"contacts", kContacts},
+      {"gravity", kGravity},
+      {"rendering", kRendering},
+      {"all", kContacts | kGravity | kRendering},
+      {"no_frictionloss", kNoFrictionloss},
+  };
+  return variants;
+}
+
+LeannessResult run_leanness_study(const LeannessOptions& o) {
+  const auto study_start = Clock::now();
+  LeannessResult result;
+  result.duration_s = o.duration_s;
+  result.repeats = std::max(1, o.repeats);
+  if (!(o.duration_s > 0.0)) throw SimError("the duration must be > 0");
+
+  std::vector<std::string> sets = o.overrides;
+  sets.push_back("duration_s=" + exact(o.duration_s));
+  // every loop is built (and every scene checked) before the first run
+  std::vector<std::vector<VariantLoop>> all(o.scenes.size());
+  for (std::size_t c = 0; c < o.scenes.size(); ++c) {
+    for (const LeannessVariant& variant : leanness_variants()) {
+      VariantLoop v;
+      v.variant = variant;
+      v.result.variant = variant;
+      v.result.wall_time_s = std::numeric_limits<double>::infinity();
+      v.result.cpu_time_s = std::numeric_limits<double>::infinity();
+      v.loop = std::make_unique<ClosedLoop>(o.scenes[c].second, sets);
+      switch_on(v.loop.get(), variant.ingredients);
+      if (variant.ingredients & kRendering) {
+        v.viewer = std::make_unique<ViewerState>(v.loop->model());
+      }
+      all[c].push_back(std::move(v));
+    }
+  }
+
+  for (std::size_t c = 0; c < o.scenes.size(); ++c) {
+    std::vector<VariantLoop>& loops = all[c];
+    const ClosedLoop& first = *loops.front().loop;
+    CaseLeanness cl;
+    cl.name = o.scenes[c].first;
+    cl.scene = o.scenes[c].second;
+    cl.nv = first.model()->nv;
+    cl.ngeom = first.model()->ngeom;
+    cl.substeps = first.substeps();
+    cl.step_s = first.model()->opt.timestep;
+    cl.ticks = first.ticks_per_run();
+
+    // each repeat starts one variant further on, so that no variant always
+    // runs first (cold caches) or right after the same neighbour
+    for (int rep = 0; rep < result.repeats; ++rep) {
+      for (std::size_t i = 0; i < loops.size(); ++i) {
+        run_variant(&loops[(i + static_cast<std::size_t>(rep)) % loops.size()],
+                    cl.ticks);
+      }
+    }
+
+    // the controller alone, over the composed run's readings
+    const VariantLoop& composed = loops.front();
+    double controller_s = std::numeric_limits<double>::infinity();
+    for (int rep = 0; rep < result.repeats; ++rep) {
+      Controller controller(composed.loop->controller_params());
+      ControlOutput out;
+      const double cpu0 = thread_cpu_s();
+      for (const Joints& q : composed.q_read) controller.tick(q, &out);
+      controller_s = std::min(controller_s, thread_cpu_s() - cpu0);
+    }
+    cl.controller_cpu_time_s = controller_s;
+
+    const double steps = static_cast<double>(cl.ticks) * cl.substeps;
+    const double simulated_s = cl.ticks * composed.loop->controller_params().servo_period_s;
+    const double composed_s = composed.result.wall_time_s;
+    const double composed_cpu_s = composed.result.cpu_time_s;
+    for (VariantLoop& v : loops) {
+      VariantResult r = v.result;
+      const mjModel* m = v.loop->model();
+      r.steps_per_s = steps / r.wall_time_s;
+      r.cpu_steps_per_s = steps / r.cpu_time_s;
+      r.realtime_factor = simulated_s / r.wall_time_s;
+      r.slowdown = r.wall_time_s / composed_s;
+      r.cpu_slowdown = r.cpu_time_s / composed_cpu_s;
+      r.physics_slowdown = (r.cpu_time_s - controller_s) /
+                           std::max(composed_cpu_s - controller_s, 1e-12);
+      r.contact_enabled = !(m->opt.disableflags & mjDSBL_CONTACT);
+      r.gravity_enabled = !(m->opt.disableflags & mjDSBL_GRAVITY) &&
+                          (m->opt.gravity[0] != 0.0 || m->opt.gravity[1] != 0.0 ||
+                           m->opt.gravity[2] != 0.0);
+      r.frictionloss_enabled = !(m->opt.disableflags & mjDSBL_FRICTIONLOSS);
+      r.colliding_geoms = 0;
+      for (int g = 0; g < m->ngeom; ++g) {
+        if (m->geom_contype[g] != 0 || m->geom_conaffinity[g] != 0) {
+          ++r.colliding_geoms;
+        }
+      }
+      r.max_deviation_mm = 0.0;
+      for (std::size_t k = 0; k < v.p_mm.size(); ++k) {
+        r.max_deviation_mm =
+            std::max(r.max_deviation_mm, (v.p_mm[k] - composed.p_mm[k]).norm());
+      }
+      cl.variants.push_back(r);
+    }
+    result.cases.push_back(cl);
+  }
+  result.study_wall_time_s =
+      std::chrono::duration<double>(Clock::now() - study_start).count();
+  return result;
+}
+
+std::string leanness_csv(const LeannessResult& r) {
+  std::string s =
+      "case,variant,contacts,gravity,rendering,frictionloss,wall_time_s,"
+      "cpu_time_s,steps_per_s,cpu_steps_per_s,realtime_factor,slowdown,"
+      "cpu_slowdown,physics_slowdown,controller_cpu_time_s,mean_ncon,max_ncon,"
+      "mean_nefc,max_nefc,colliding_geoms,scene_geoms,render_us_per_tick,"
+      "max_deviation_mm,mujoco_warnings\n";
+  char buf[512];
+  for (const CaseLeanness& c : r.cases) {
+    for (const VariantResult& v : c.variants) {
+      std::snprintf(buf, sizeof buf,
+                    "%s,%s,%d,%d,%d,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"
+                    "%.6g,%.9g,%.6g,%d,%.6g,%d,%d,%d,%.6g,%.9g,%d\n",
+                    c.name.c_str(), v.variant.name.c_str(),
+                    v.contact_enabled ? 1 : 0, v.gravity_enabled ? 1 : 0,
+                    (v.variant.ingredients & kRendering) ? 1 : 0,
+                    v.frictionloss_enabled ? 1 : 0, v.wall_time_s,
+                    v.cpu_time_s, v.steps_per_s, v.cpu_steps_per_s,
+                    v.realtime_factor, v.slowdown, v.cpu_slowdown,
+                    v.physics_slowdown, c.controller_cpu_time_s, v.mean_ncon,
+                    v.max_ncon, v.mean_nefc, v.max_nefc, v.colliding_geoms,
+                    v.scene_geoms, v.render_us_per_tick, v.max_deviation_mm,
+                    v.mujoco_warnings);
+      s += buf;
+    }
+  }
+  return s;
+}
+
+}  // namespace vmh::sim

@@ -1,0 +1,672 @@
+#include "studies/plot_svg.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "report/svg_text.h"
+
+namespace vmh::sim {
+namespace {
+
+using svg::attr;
+using svg::escape;
+using svg::format;
+using svg::nice_step;
+using svg::px;
+
+using Pt = std::pair<double, double>;
+
+// ---------------------------------------------------------------- text
+
+// a number a reader reads: tick labels, titles
+std::string num(double v) {
+  std::string s = format("%.4g", v);
+  if (s == "-0") s = "0";
+  return s;
+}
+
+// ---------------------------------------------------------------- writer
+
+// Appends SVG elements to a string. `attrs` are extra attributes, each
+// starting with a space (attr() makes them).
+class Svg {
+ public:
+  Svg(double width, double height) {
+    s_ = "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\"" +
+         attr("width", px(width)) + attr("height", px(height)) +
+         attr("viewBox", "0 0 " + px(width) + " " + px(height)) +
+         " font-family=\"sans-serif\" font-size=\"11\">\n";
+    rect(0.0, 0.0, width, height, attr("fill", "white"));
+  }
+
+  void line(double x1, double y1, double x2, double y2,
+            const std::string& attrs) {
+    s_ += "<line" + attr("x1", px(x1)) + attr("y1", px(y1)) +
+          attr("x2", px(x2)) + attr("y2", px(y2)) + attrs + "/>\n";
+  }
+  // non-finite points are left out
+  void polyline(const std::vector<Pt>& pts, const std::string& attrs) {
+    std::string p;
+    int n = 0;
+    for (const Pt& q : pts) {
+      if (!std::isfinite(q.first) || !std::isfinite(q.second)) continue;
+      if (n++ > 0) p += ' ';
+      p += px(q.first) + "," + px(q.second);
+    }
+    if (n < 2) return;
+    s_ += "<polyline fill=\"none\" points=\"" + p + "\"" + attrs + "/>\n";
+  }
+  void polygon(const std::vector<Pt>& pts, const std::string& attrs) {
+    std::string p;
+    for (const Pt& q : pts) {
+      if (!p.empty()) p += ' ';
+      p += px(q.first) + "," + px(q.second);
+    }
+    s_ += "<polygon points=\"" + p + "\"" + attrs + "/>\n";
+  }
+  void circle(double cx, double cy, double r, const std::string& attrs) {
+    s_ += "<circle" + attr("cx", px(cx)) + attr("cy", px(cy)) +
+          attr("r", px(r)) + attrs + "/>\n";
+  }
+  void rect(double x, double y, double w, double h, const std::string& attrs) {
+    s_ += "<rect" + attr("x", px(x)) + attr("y", px(y)) +
+          attr("width", px(std::max(w, 0.0))) +
+          attr("height", px(std::max(h, 0.0))) + attrs + "/>\n";
+  }
+  void text(double x, double y, const std::string& t,
+            const std::string& attrs) {
+    s_ += "<text" + attr("x", px(x)) + attr("y", px(y)) + attrs + ">" +
+          escape(t) + "</text>\n";
+  }
+  // text turned to read upward, centred on (x, y)
+  void vertical_text(double x, double y, const std::string& t,
+                     const std::string& attrs) {
+    text(x, y, t,
+         attr("transform", "rotate(-90 " + px(x) + " " + px(y) + ")") +
+             attr("text-anchor", "middle") + attrs);
+  }
+  void open(const std::string& tag, const std::string& attrs) {
+    s_ += "<" + tag + attrs + ">\n";
+  }
+  void close(const std::string& tag) { s_ += "</" + tag + ">\n"; }
+  // a clip path named `id` around a rectangle
+  void clip_rect(const std::string& id, double x, double y, double w,
+                 double h) {
+    open("clipPath", attr("id", id));
+    rect(x, y, w, h, "");
+    close("clipPath");
+  }
+
+  std::string finish() const { return s_ + "</svg>\n"; }
+
+ private:
+  std::string s_;
+};
+
+// ---------------------------------------------------------------- axes
+
+struct Bounds {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+  void add(double v) {
+    if (!std::isfinite(v)) return;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  bool empty() const { return !(lo <= hi); }
+};
+
+long step_index_up(double v, double step) {
+  return static_cast<long>(std::ceil(v / step - 1e-9));
+}
+long step_index_down(double v, double step) {
+  return static_cast<long>(std::floor(v / step + 1e-9));
+}
+
+// the multiples of `step` in [lo, hi], with -0 and rounding noise removed
+std::vector<double> ticks(double lo, double hi, double step) {
+  std::vector<double> t;
+  for (long k = step_index_up(lo, step); k <= step_index_down(hi, step); ++k) {
+    t.push_back(static_cast<double>(k) * step);
+  }
+  return t;
+}
+
+// A plot area: data ranges mapped to a pixel rectangle, y up.
+struct Frame {
+  double left = 0.0, top = 0.0, width = 1.0, height = 1.0;  // px
+  double xlo = 0.0, xhi = 1.0, ylo = 0.0, yhi = 1.0;        // data
+  double xstep = 1.0, ystep = 1.0;                           // ticks
+
+  double X(double x) const { return left + (x - xlo) / (xhi - xlo) * width; }
+  double Y(double y) const { return top + (yhi - y) / (yhi - ylo) * height; }
+  Pt at(double x, double y) const { return {X(x), Y(y)}; }
+};
+
+// Grid, frame, ticks with numbers and the axis labels. The x numbers and
+// label are left out when x_numbers is false (panels sharing a time axis).
+void draw_axes(Svg& svg, const Frame& f, const std::string& xlabel,
+               const std::string& ylabel, bool x_numbers) {
+  const double bottom = f.top + f.height;
+  for (double x : ticks(f.xlo, f.xhi, f.xstep)) {
+    const double X = f.X(x);
+    svg.line(X, f.top, X, bottom, attr("stroke", "#e4e4e4"));
+    svg.line(X, bottom, X, bottom + 4.0, attr("stroke", "#444"));
+    if (x_numbers) {
+      svg.text(X, bottom + 15.0, num(x), attr("text-anchor", "middle"));
+    }
+  }
+  for (double y : ticks(f.ylo, f.yhi, f.ystep)) {
+    const double Y = f.Y(y);
+    svg.line(f.left, Y, f.left + f.width, Y,
+             attr("stroke", y == 0.0 ? "#b0b0b0" : "#e4e4e4"));
+    svg.line(f.left - 4.0, Y, f.left, Y, attr("stroke", "#444"));
+    svg.text(f.left - 6.0, Y + 4.0, num(y), attr("text-anchor", "end"));
+  }
+  svg.rect(f.left, f.top, f.width, f.height,
+           attr("fill", "none") + attr("stroke", "#444"));
+  if (x_numbers) {
+    svg.text(f.left + 0.5 * f.width, bottom + 32.0, xlabel,
+             attr("text-anchor", "middle"));
+  }
+  svg.vertical_text(f.left - 44.0, f.top + 0.5 * f.height, ylabel, "");
+}
+
+// every k-th index of n so that at most kPlotMaxPoints are kept, and n - 1
+std::vector<std::size_t> decimated(std::size_t n) {
+  std::vector<std::size_t> idx;
+  if (n == 0) return idx;
+  const std::size_t k = (n + kPlotMaxPoints - 1) / kPlotMaxPoints;
+  for (std::size_t i = 0; i < n; i += k) idx.push_back(i);
+  if (idx.back() != n - 1) idx.push_back(n - 1);
+  return idx;
+}
+
+// an arrow from (x1, y1) to (x2, y2) in px: the shaft is a <line> carrying
+// `attrs` (and an id), the head a polygon
+void arrow(Svg& svg, double x1, double y1, double x2, double y2,
+           const std::string& color, const std::string& attrs) {
+  svg.line(x1, y1, x2, y2,
+           attr("stroke", color) + attr("stroke-width", "2") + attrs);
+  const double dx = x2 - x1, dy = y2 - y1;
+  const double len = std::hypot(dx, dy);
+  if (len < 4.0) return;
+  const double ux = dx / len, uy = dy / len;
+  const double head = std::min(9.0, 0.5 * len), half = 0.4 * head;
+  const double bx = x2 - head * ux, by = y2 - head * uy;
+  svg.polygon({{x2, y2}, {bx - half * uy, by + half * ux},
+               {bx + half * uy, by - half * ux}},
+              attr("fill", color));
+}
+
+std::string case_name(const ClosedLoop& loop) {
+  const std::string stem =
+      std::filesystem::path(loop.config().scene_path()).stem().string();
+  return stem.empty() ? std::string("run") : stem;
+}
+
+std::string empty_document(const std::string& title) {
+  Svg svg(480.0, 60.0);
+  svg.text(10.0, 35.0, title + ": no rows to plot", attr("font-size", "14"));
+  return svg.finish();
+}
+
+// ---------------------------------------------------------------- views
+
+// a view: the horizontal and vertical axes as device-frame directions
+struct Projection {
+  std::string tag;    // "" or "xy", "xz", "zy"
+  std::string title;  // shown under the panel's title
+  Vec3 a, b;
+  std::string xlabel, ylabel;
+};
+
+struct Snapshot {
+  const char* segment;
+  const char* tag;
+  const char* what;
+  const TraceRow* row = nullptr;
+  std::string note;  // why there is no row
+};
+
+// the row nearest the middle of the settled half of `segment`, if the run
+// has one within a servo period of it
+void find_snapshot(const std::vector<TraceRow>& rows, const ClosedLoop& loop,
+                   Snapshot* s) {
+  const ScriptSegment* seg = nullptr;
+  for (const ScriptSegment& g : loop.script().segments()) {
+    if (g.name == s->segment) seg = &g;
+  }
+  if (seg == nullptr) {
+    s->note = std::string("the script has no segment ") + s->segment;
+    return;
+  }
+  const double mid = 0.5 * (seg->settled_from_s() + seg->t1_s);
+  const TraceRow* best = nullptr;
+  for (const TraceRow& r : rows) {
+    if (best == nullptr || std::abs(r.t_s - mid) < std::abs(best->t_s - mid)) {
+      best = &r;
+    }
+  }
+  const double tol = 1.5 * loop.controller_params().servo_period_s;
+  if (best == nullptr || std::abs(best->t_s - mid) > tol) {
+    s->note = "t = " + num(mid) + " s (" + s->segment + ") is not in the run";
+    return;
+  }
+  s->row = best;
+}
+
+struct ViewLayout {
+  static constexpr double kPlot = 340.0;      // square plot area, px
+  static constexpr double kLeft = 62.0;       // room for y numbers, label
+  static constexpr double kTop = 44.0;        // two title lines
+  static constexpr double kCellW = kLeft + kPlot + 22.0;
+  static constexpr double kCellH = kTop + kPlot + 46.0;
+  static constexpr double kHeader = 30.0;
+  static constexpr double kLegendW = 300.0;
+};
+
+void view_panel(Svg& svg, double ox, double oy, const std::string& name,
+                const Snapshot& snap, const Projection& proj,
+                const std::vector<TraceRow>& rows, const VmParams& vm) {
+  const std::string tag =
+      std::string(snap.tag) + (proj.tag.empty() ? "" : "-" + proj.tag);
+  auto u = [&](const Vec3& p) { return proj.a.dot(p); };
+  auto v = [&](const Vec3& p) { return proj.b.dot(p); };
+  const double L = vm.length_mm;
+  const bool outline = vm.kind != VmKind::kSurface;
+  const Vec3 n = vm.R_pivot.col(2);
+  // the surface's path (the handle L above the plane) is a line in views
+  // that hold the normal, and fills the others
+  const bool surface_line =
+      vm.kind == VmKind::kSurface &&
+      (n - proj.a.dot(n) * proj.a - proj.b.dot(n) * proj.b).norm() < 1e-6;
+  const std::vector<std::size_t> idx = decimated(rows.size());
+
+  // what must be in view
+  Bounds bu, bv;
+  auto add = [&](const Vec3& p) {
+    bu.add(u(p));
+    bv.add(v(p));
+  };
+  add(vm.pivot_mm);
+  if (outline) {
+    bu.add(u(vm.pivot_mm) - L);
+    bu.add(u(vm.pivot_mm) + L);
+    bv.add(v(vm.pivot_mm) - L);
+    bv.add(v(vm.pivot_mm) + L);
+  } else {
+    add(vm.pivot_mm + L * n);
+    add(vm.pivot_mm - L * n);
+  }
+  for (std::size_t i : idx) add(rows[i].out.p_rm_mm);
+  const TraceRow* r = snap.row;
+  if (r != nullptr) {
+    const ControlOutput& o = r->out;
+    add(o.p_rm_mm);
+    add(o.x_v_mm);
+    add(o.x_r_mm);
+    add(o.p_rm_mm + kPlotStylusMm * o.axis_rm);
+    add(o.p_rm_mm + kPlotForceMmPerN * o.force_device_N);
+  }
+  if (bu.empty() || bv.empty()) {
+    bu = Bounds{-L, L};
+    bv = Bounds{-L, L};
+  }
+
+  // a square of whole ticks around it, with a margin
+  const double pad = 8.0;
+  const double span = std::max({bu.hi - bu.lo, bv.hi - bv.lo, 10.0}) + 2 * pad;
+  const double step = nice_step(span, 6.0);
+  const double cu = 0.5 * (bu.lo + bu.hi), cv = 0.5 * (bv.lo + bv.hi);
+  long u0 = step_index_down(cu - 0.5 * span, step);
+  long u1 = step_index_up(cu + 0.5 * span, step);
+  long v0 = step_index_down(cv - 0.5 * span, step);
+  long v1 = step_index_up(cv + 0.5 * span, step);
+  const long cells = std::max(u1 - u0, v1 - v0);
+  u0 -= (cells - (u1 - u0)) / 2;
+  u1 = u0 + cells;
+  v0 -= (cells - (v1 - v0)) / 2;
+  v1 = v0 + cells;
+
+  Frame f;
+  f.left = ox + ViewLayout::kLeft;
+  f.top = oy + ViewLayout::kTop;
+  f.width = f.height = ViewLayout::kPlot;
+  f.xlo = static_cast<double>(u0) * step;
+  f.xhi = static_cast<double>(u1) * step;
+  f.ylo = static_cast<double>(v0) * step;
+  f.yhi = static_cast<double>(v1) * step;
+  f.xstep = f.ystep = step;
+  const double mm = f.width / (f.xhi - f.xlo);  // px per mm, both axes
+
+  svg.open("g", attr("class", "panel") + attr("id", "panel-" + tag));
+  std::string title = name + ": " + snap.what;
+  if (r != nullptr) {
+    title += " (t = " + format("%.3f", r->t_s) + " s, d = " +
+             format("%.3g", r->d_path_mm) + " mm)";
+  }
+  svg.text(f.left, oy + 16.0, title,
+           attr("font-size", "12") + attr("font-weight", "bold"));
+  svg.text(f.left, oy + 31.0,
+           (r != nullptr ? std::string("stylus misaligned; ") : snap.note + "; ") +
+               proj.title,
+           attr("fill", "#444"));
+  draw_axes(svg, f, proj.xlabel, proj.ylabel, true);
+
+  svg.clip_rect("clip-" + tag, f.left, f.top, f.width, f.height);
+  svg.open("g", attr("clip-path", "url(#clip-" + tag + ")"));
+  const double pu = u(vm.pivot_mm), pv = v(vm.pivot_mm);
+  if (outline) {
+    svg.circle(f.X(pu), f.Y(pv), L * mm,
+               attr("id", "path-" + tag) + attr("fill", "none") +
+                   attr("stroke", "#555") + attr("stroke-width", "1.2"));
+  } else if (surface_line) {
+    // both sides of the plane, as far as the frame
+    const double du = -v(n), dv = u(n);
+    const double far = 10.0 * (f.xhi - f.xlo);
+    for (double side : {-1.0, 1.0}) {
+      const Vec3 c = vm.pivot_mm + side * L * n;
+      svg.line(f.X(u(c) - far * du), f.Y(v(c) - far * dv),
+               f.X(u(c) + far * du), f.Y(v(c) + far * dv),
+               attr("stroke", "#555") + attr("stroke-dasharray", "6 3"));
+    }
+  }
+  std::vector<Pt> trail;
+  trail.reserve(idx.size());
+  for (std::size_t i : idx) {
+    trail.push_back(f.at(u(rows[i].out.p_rm_mm), v(rows[i].out.p_rm_mm)));
+  }
+  svg.polyline(trail, attr("stroke", "#a8a8a8") + attr("stroke-width", "0.8"));
+  // the pivot
+  svg.line(f.X(pu) - 4, f.Y(pv), f.X(pu) + 4, f.Y(pv), attr("stroke", "#000"));
+  svg.line(f.X(pu), f.Y(pv) - 4, f.X(pu), f.Y(pv) + 4, attr("stroke", "#000"));
+
+  if (r != nullptr) {
+    const ControlOutput& o = r->out;
+    const Vec3& p = o.p_rm_mm;
+    svg.line(f.X(pu), f.Y(pv), f.X(u(o.x_v_mm)), f.Y(v(o.x_v_mm)),
+             attr("id", "xv-" + tag) + attr("stroke", "#d00000") +
+                 attr("stroke-width", "2"));
+    svg.circle(f.X(u(o.x_v_mm)), f.Y(v(o.x_v_mm)), 2.5, attr("fill", "#d00000"));
+    svg.line(f.X(pu), f.Y(pv), f.X(u(o.x_r_mm)), f.Y(v(o.x_r_mm)),
+             attr("id", "xr-" + tag) + attr("stroke", "#00a000") +
+                 attr("stroke-width", "2"));
+    svg.circle(f.X(u(o.x_r_mm)), f.Y(v(o.x_r_mm)), 2.5, attr("fill", "#00a000"));
+    const Vec3 tip = p + kPlotStylusMm * o.axis_rm;
+    svg.line(f.X(u(p)), f.Y(v(p)), f.X(u(tip)), f.Y(v(tip)),
+             attr("id", "stylus-" + tag) + attr("stroke", "#000") +
+                 attr("stroke-width", "3") + attr("stroke-linecap", "round"));
+    // the force and its components in this view
+    const Vec3 F = kPlotForceMmPerN * o.force_device_N;
+    const std::string thin = attr("stroke", "#c000c0") +
+                             attr("stroke-width", "1") +
+                             attr("stroke-dasharray", "3 2");
+    svg.line(f.X(u(p)), f.Y(v(p)), f.X(u(p) + u(F)), f.Y(v(p)), thin);
+    svg.line(f.X(u(p)), f.Y(v(p)), f.X(u(p)), f.Y(v(p) + v(F)), thin);
+    arrow(svg, f.X(u(p)), f.Y(v(p)), f.X(u(p) + u(F)), f.Y(v(p) + v(F)),
+          "#c000c0", attr("id", "force-" + tag));
+    svg.circle(f.X(u(p)), f.Y(v(p)), 3.0,
+               attr("id", "p-" + tag) + attr("fill", "#000"));
+  }
+  svg.close("g");
+  svg.close("g");
+}
+
+void view_legend(Svg& svg, double x, double y, const VmParams& vm) {
+  const std::string kind = vm.kind == VmKind::kCircle   ? "circle"
+                           : vm.kind == VmKind::kSphere ? "sphere (outline)"
+                                                        : "surface (plane + L)";
+  svg.open("g", attr("id", "legend"));
+  svg.text(x, y, "Legend", attr("font-weight", "bold"));
+  double yy = y + 20.0;
+  auto item = [&](const std::string& label,
+                  const std::function<void(double, double)>& sample) {
+    sample(x, yy);
+    svg.text(x + 34.0, yy + 4.0, label, "");
+    yy += 20.0;
+  };
+  auto stroke = [&](const char* color, const char* width, const char* dash) {
+    return [&svg, color, width, dash](double x0, double y0) {
+      svg.line(x0, y0, x0 + 26.0, y0,
+               attr("stroke", color) + attr("stroke-width", width) +
+                   (dash[0] != '\0' ? attr("stroke-dasharray", dash) : ""));
+    };
+  };
+  item("VM path: " + kind + ", L = " + num(vm.length_mm) + " mm",
+       stroke("#555", "1.2", vm.kind == VmKind::kSurface ? "6 3" : ""));
+  item("RM wrist centre p over the run", stroke("#a8a8a8", "0.8", ""));
+  item("p at the snapshot", [&svg](double x0, double y0) {
+    svg.circle(x0 + 13.0, y0, 3.0, attr("fill", "#000"));
+  });
+  item("pivot -> X(theta_V), the placed VM", stroke("#d00000", "2", ""));
+  item("pivot -> X(theta_R), VM along the stylus", stroke("#00a000", "2", ""));
+  item("stylus axis a at p, " + num(kPlotStylusMm) + " mm",
+       stroke("#000", "3", ""));
+  item("force F from p, " + num(kPlotForceMmPerN) + " mm per N",
+       [&svg](double x0, double y0) {
+         arrow(svg, x0, y0, x0 + 26.0, y0, "#c000c0", "");
+       });
+  item("components of F in the view", stroke("#c000c0", "1", "3 2"));
+  item("pivot at (" + num(vm.pivot_mm.x()) + ", " + num(vm.pivot_mm.y()) +
+           ", " + num(vm.pivot_mm.z()) + ") mm",
+       [&svg](double x0, double y0) {
+         svg.line(x0 + 9.0, y0, x0 + 17.0, y0, attr("stroke", "#000"));
+         svg.line(x0 + 13.0, y0 - 4.0, x0 + 13.0, y0 + 4.0,
+                  attr("stroke", "#000"));
+       });
+  svg.text(x, yy + 10.0, "Device frame, mm; equal aspect.", attr("fill", "#444"));
+  svg.text(x, yy + 26.0, "Snapshots: middle of the settled half of",
+           attr("fill", "#444"));
+  svg.text(x, yy + 40.0, "off_out_misaligned and on_misaligned_a.",
+           attr("fill", "#444"));
+  svg.close("g");
+}
+
+// ---------------------------------------------------------------- history
+
+struct Series {
+  std::string name;
+  std::string color;
+  std::string dash;  // "" solid
+  std::function<double(const TraceRow&)> value;
+};
+
+struct HistoryPanel {
+  std::string ylabel;
+  std::string heading;
+  std::vector<Series> series;
+};
+
+}  // namespace
+
+std::string views_svg(const std::vector<TraceRow>& rows,
+                      const ClosedLoop& loop) {
+  const std::string name = case_name(loop);
+  if (rows.empty()) return empty_document(name);
+  const VmParams& vm = loop.controller_params().vm;
+
+  std::vector<Snapshot> snaps = {
+      {"off_out_misaligned", "off", "RM off the path", nullptr, ""},
+      {"on_misaligned_a", "on", "RM on the path", nullptr, ""},
+  };
+  for (Snapshot& s : snaps) find_snapshot(rows, loop, &s);
+
+  std::vector<Projection> projs;
+  if (vm.kind == VmKind::kCircle) {
+    const bool device = vm.R_pivot.isApprox(Mat3::Identity(), 1e-12);
+    projs.push_back({"", device ? "circle plane (device x-y)"
+                                : "circle plane (pivot frame x-y)",
+                     vm.R_pivot.col(0), vm.R_pivot.col(1),
+                     device ? "x_mm" : "x_pivot_mm",
+                     device ? "y_mm" : "y_pivot_mm"});
+  } else {
+    projs.push_back({"xy", "x-y view", Vec3::UnitX(), Vec3::UnitY(), "x_mm",
+                     "y_mm"});
+    projs.push_back({"xz", "x-z view", Vec3::UnitX(), Vec3::UnitZ(), "x_mm",
+                     "z_mm"});
+    projs.push_back({"zy", "z-y view", Vec3::UnitZ(), Vec3::UnitY(), "z_mm",
+                     "y_mm"});
+  }
+
+  const double cols = static_cast<double>(projs.size()) *
+                      (projs.size() == 1 ? 2.0 : 1.0);
+  const double nrows = projs.size() == 1 ? 1.0 : 2.0;
+  const double width = cols * ViewLayout::kCellW + ViewLayout::kLegendW;
+  const double height =
+      ViewLayout::kHeader + nrows * ViewLayout::kCellH + 10.0;
+  Svg svg(width, height);
+  svg.text(12.0, 20.0,
+           name + ": the RM and the VM, off and on the path (cf. thesis Figs " +
+               (vm.kind == VmKind::kCircle ? "4.1-4.2)" : "4.13-4.18)"),
+           attr("font-size", "14") + attr("font-weight", "bold"));
+  for (std::size_t s = 0; s < snaps.size(); ++s) {
+    for (std::size_t k = 0; k < projs.size(); ++k) {
+      // the circle: snapshots side by side; three views: one row each
+      const double col = static_cast<double>(projs.size() == 1 ? s : k);
+      const double row = static_cast<double>(projs.size() == 1 ? 0 : s);
+      view_panel(svg, col * ViewLayout::kCellW,
+                 ViewLayout::kHeader + row * ViewLayout::kCellH, name,
+                 snaps[s], projs[k], rows, vm);
+    }
+  }
+  view_legend(svg, cols * ViewLayout::kCellW + 10.0,
+              ViewLayout::kHeader + ViewLayout::kTop + 10.0, vm);
+  return svg.finish();
+}
+
+std::string history_svg(const std::vector<TraceRow>& rows,
+                        const ClosedLoop& loop) {
+  const std::string name = case_name(loop);
+  if (rows.empty()) return empty_document(name);
+
+  const char* const kColor[3] = {"#d62728", "#2ca02c", "#1f77b4"};
+  const char* const kAxis[3] = {"x", "y", "z"};
+  std::vector<HistoryPanel> panels(3);
+  panels[0].ylabel = "(a) p - X(theta_V), mm";
+  panels[0].heading = "(a) p - X(theta_V), mm";
+  panels[1].ylabel = "(b) p - X(theta_R), mm";
+  panels[1].heading = "(b) p - X(theta_R), mm";
+  panels[2].ylabel = "(c) force F, N";
+  panels[2].heading = "(c) commanded force, N";
+  for (int i = 0; i < 3; ++i) {
+    const std::string c = kAxis[i];
+    panels[0].series.push_back({c, kColor[i], "", [i](const TraceRow& r) {
+                                  return r.out.p_rm_mm[i] - r.out.x_v_mm[i];
+                                }});
+    panels[1].series.push_back({c, kColor[i], "", [i](const TraceRow& r) {
+                                  return r.out.p_rm_mm[i] - r.out.x_r_mm[i];
+                                }});
+    panels[2].series.push_back({"F_" + c, kColor[i], "", [i](const TraceRow& r) {
+                                  return r.out.force_device_N[i];
+                                }});
+  }
+  panels[0].series.push_back({"d_path (distance to the path)", "#000", "5 3",
+                              [](const TraceRow& r) { return r.d_path_mm; }});
+  panels[2].series.push_back({"|F|", "#000", "5 3", [](const TraceRow& r) {
+                                return r.out.force_device_N.norm();
+                              }});
+
+  const double left = 76.0, plot_w = 800.0, plot_h = 180.0, gap = 22.0;
+  const double top0 = 58.0;
+  const double legend_x = left + plot_w + 22.0;
+  const double width = legend_x + 230.0;
+  const double height = top0 + 3.0 * plot_h + 2.0 * gap + 52.0;
+  Svg svg(width, height);
+  svg.text(12.0, 20.0,
+           name + ": time history of error and force (cf. thesis Figs 4.3, "
+                  "4.6, 4.19); device frame",
+           attr("font-size", "14") + attr("font-weight", "bold"));
+
+  double t0 = rows.front().t_s, t1 = rows.back().t_s;
+  if (!(t1 > t0)) t1 = t0 + 1e-3;
+  const double tstep = nice_step(t1 - t0, 10.0);
+  // end on a tick when the run nearly does (the last tick is at T - period)
+  const double t_end = static_cast<double>(step_index_up(t1, tstep)) * tstep;
+  if (t_end - t1 < 0.02 * (t1 - t0)) t1 = t_end;
+  const std::vector<std::size_t> idx = decimated(rows.size());
+  const std::vector<ScriptSegment>& segs = loop.script().segments();
+
+  for (std::size_t k = 0; k < panels.size(); ++k) {
+    const HistoryPanel& hp = panels[k];
+    Frame f;
+    f.left = left;
+    f.top = top0 + static_cast<double>(k) * (plot_h + gap);
+    f.width = plot_w;
+    f.height = plot_h;
+    f.xlo = t0;
+    f.xhi = t1;
+    f.xstep = tstep;
+    Bounds b;
+    b.add(0.0);
+    for (const Series& s : hp.series) {
+      for (std::size_t i : idx) b.add(s.value(rows[i]));
+    }
+    if (b.hi - b.lo < 1e-9) b.hi = b.lo + 1.0;
+    const double pad = 0.05 * (b.hi - b.lo);
+    f.ystep = nice_step(b.hi - b.lo + 2 * pad, 5.0);
+    f.ylo = static_cast<double>(step_index_down(b.lo - pad, f.ystep)) * f.ystep;
+    f.yhi = static_cast<double>(step_index_up(b.hi + pad, f.ystep)) * f.ystep;
+
+    const std::string tag = std::string(1, static_cast<char>('a' + k));
+    svg.open("g", attr("class", "history") + attr("id", "history-" + tag));
+    // the script's segments: alternate shading, boundaries, names on top
+    for (std::size_t s = 0; s < segs.size(); ++s) {
+      const double a = std::max(segs[s].t0_s, t0), e = std::min(segs[s].t1_s, t1);
+      if (!(e > a)) continue;
+      if (s % 2 == 1) {
+        svg.rect(f.X(a), f.top, f.X(e) - f.X(a), f.height, attr("fill", "#f3f3f3"));
+      }
+      if (segs[s].t0_s > t0 && segs[s].t0_s < t1) {
+        svg.line(f.X(segs[s].t0_s), f.top, f.X(segs[s].t0_s), f.top + f.height,
+                 attr("stroke", "#888") + attr("stroke-width", "0.7") +
+                     attr("stroke-dasharray", "3 3"));
+      }
+      if (k == 0) {
+        svg.text(0.5 * (f.X(a) + f.X(e)), f.top - (s % 2 == 0 ? 16.0 : 5.0),
+                 segs[s].name,
+                 attr("class", "segment") + attr("text-anchor", "middle") +
+                     attr("font-size", "9") + attr("fill", "#555"));
+      }
+    }
+    draw_axes(svg, f, "t_s", hp.ylabel, k + 1 == panels.size());
+    svg.clip_rect("clip-history-" + tag, f.left, f.top, f.width, f.height);
+    svg.open("g", attr("clip-path", "url(#clip-history-" + tag + ")"));
+    for (const Series& s : hp.series) {
+      std::vector<Pt> pts;
+      pts.reserve(idx.size());
+      for (std::size_t i : idx) pts.push_back(f.at(rows[i].t_s, s.value(rows[i])));
+      svg.polyline(pts, attr("stroke", s.color) + attr("stroke-width", "1") +
+                            (s.dash.empty() ? "" : attr("stroke-dasharray", s.dash)));
+    }
+    svg.close("g");
+    // legend
+    svg.text(legend_x, f.top + 12.0, hp.heading, attr("font-weight", "bold"));
+    double yy = f.top + 30.0;
+    for (const Series& s : hp.series) {
+      svg.line(legend_x, yy - 4.0, legend_x + 24.0, yy - 4.0,
+               attr("stroke", s.color) + attr("stroke-width", "1.5") +
+                   (s.dash.empty() ? "" : attr("stroke-dasharray", s.dash)));
+      svg.text(legend_x + 30.0, yy, s.name, "");
+      yy += 16.0;
+    }
+    svg.close("g");
+  }
+  const std::size_t every = idx.size() > 1 ? idx[1] - idx[0] : 1;
+  svg.text(legend_x, height - 22.0,
+           "plotted: 1 tick in " + std::to_string(every) + " of " +
+               std::to_string(rows.size()),
+           attr("fill", "#444") + attr("font-size", "10"));
+  svg.text(legend_x, height - 8.0, "shaded / dashed: script segments",
+           attr("fill", "#444") + attr("font-size", "10"));
+  return svg.finish();
+}
+
+}  // namespace vmh::sim

@@ -1,0 +1,561 @@
+#include "studies/precision_study.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <limits>
+#include <memory>
+#include <thread>
+
+#include <time.h>
+
+#include "controller/device_frame.h"
+#include "controller/omni_kinematics.h"
+#include "sim/closed_loop.h"
+#include "sim/mujoco_util.h"
+
+namespace vmh::sim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// "%.17g": round-trips through the case loader's strtod
+std::string exact(double x) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+// What a run leaves behind, one entry per servo tick, sampled at the end of
+// the tick (t = (k + 1) T): the start state is the same for every run.
+struct Trajectory {
+  std::vector<Vec3> p_mm;       // true wrist centre, device frame
+  std::vector<Vec3> axis;       // true stylus axis, device frame, unit
+  std::vector<Vec3> tau_Nm;     // motor torques the controller commanded
+  std::vector<int> status;
+  std::vector<int> iterations;  // placement iterations
+  int substeps = 0;
+  int mujoco_warnings = 0;
+  bool finite = true;
+  double wall_time_s = 0.0;     // the fastest repeat
+  double cpu_time_s = 0.0;      // the thread's CPU time, least of the repeats
+  int repeats = 0;
+};
+
+// CPU time of the calling thread (s): unlike the wall clock, it does not
+// count the time other processes held the core, which on a shared machine
+// is most of the noise (POSIX clock_gettime)
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+int warning_count(const mjData* d) {
+  int n = 0;
+  for (int i = 0; i < mjNWARNING; ++i) n += d->warning[i].number;
+  return n;
+}
+
+std::vector<std::string> run_overrides(const PrecisionOptions& o,
+                                       Integrator integrator, double step_s) {
+  std::vector<std::string> sets = o.overrides;
+  sets.push_back("quantize=0");
+  sets.push_back(std::string("integrator=") + integrator_name(integrator));
+  sets.push_back("physics_step_s=" + exact(step_s));
+  return sets;
+}
+
+// One loop, run for `ticks` servo ticks; repeated (from reset()) while the
+// repeats took less than min_timing_s, up to max_repeats, and the fastest
+// repeat's time kept. Every repeat samples the trajectory the same way (a
+// forward kinematics per tick, well under 1% of a tick) and must reproduce
+// the first one exactly (MuJoCo and the controller are deterministic), else
+// SimError.
+Trajectory run_loop(ClosedLoop* loop, int ticks, double min_timing_s,
+                    int max_repeats) {
+  const OmniParams& omni = loop->controller_params().omni;
+  const std::size_t n = static_cast<std::size_t>(ticks);
+  Trajectory tr, again;
+  for (Trajectory* t : {&tr, &again}) {
+    t->p_mm.resize(n);
+    t->axis.resize(n);
+    t->tau_Nm.resize(n);
+    t->status.resize(n);
+    t->iterations.resize(n);
+  }
+  tr.substeps = loop->substeps();
+
+  TraceRow row;
+  double spent_s = 0.0;
+  double best_s = std::numeric_limits<double>::infinity();
+  double best_cpu_s = std::numeric_limits<double>::infinity();
+  for (int rep = 0; rep < std::max(1, max_repeats); ++rep) {
+    if (rep > 0 && spent_s >= min_timing_s) break;
+    Trajectory& t = rep == 0 ? tr : again;
+    loop->reset();
+    const auto t0 = Clock::now();
+    const double cpu0 = thread_cpu_s();
+    for (std::size_t k = 0; k < n; ++k) {
+      loop->tick(&row);
+      const OmniPose pose = omni_fk(omni, loop->device().true_q_dh());
+      t.p_mm[k] = base_to_device_mm(omni, pose.p_base_m);
+      t.axis[k] = base_to_device_vector(pose.R_base.col(2));
+      t.tau_Nm[k] = row.out.tau_motor_Nm;
+      t.status[k] = row.out.status;
+      t.iterations[k] = row.out.placement_iterations;
+    }
+    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    spent_s += dt;
+    best_s = std::min(best_s, dt);
+    best_cpu_s = std::min(best_cpu_s, thread_cpu_s() - cpu0);
+    ++tr.repeats;
+    if (rep == 0) {
+      tr.mujoco_warnings = warning_count(loop->data());
+      for (const Vec3& p : tr.p_mm) tr.finite &= p.allFinite();
+      tr.finite &= tr.mujoco_warnings == 0;
+      // a run that blew up is not timed again
+      if (!tr.finite) break;
+    } else if (again.p_mm != tr.p_mm || again.tau_Nm != tr.tau_Nm) {
+      throw SimError(loop->config().scene_path() +
+                     ": a repeated run did not reproduce the first");
+    }
+  }
+  tr.wall_time_s = best_s;
+  tr.cpu_time_s = best_cpu_s;
+  return tr;
+}
+
+Trajectory run_setting(const PrecisionOptions& o, Integrator integrator,
+                       double step_s, int ticks, double min_timing_s,
+                       int max_repeats) {
+  ClosedLoop loop(o.scene, run_overrides(o, integrator, step_s));
+  return run_loop(&loop, ticks, min_timing_s, max_repeats);
+}
+
+TrajectoryError compare(const Trajectory& run, const Trajectory& ref) {
+  TrajectoryError e;
+  const std::size_t n = std::min(run.p_mm.size(), ref.p_mm.size());
+  double sum_p = 0.0, sum_a = 0.0, sum_t = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double dp = (run.p_mm[k] - ref.p_mm[k]).norm();
+    const double cos_a = std::clamp(run.axis[k].dot(ref.axis[k]), -1.0, 1.0);
+    // atan2 of |a x b| and a.b: accurate at small angles, unlike acos
+    const double da = std::atan2(run.axis[k].cross(ref.axis[k]).norm(), cos_a);
+    const double dt = (run.tau_Nm[k] - ref.tau_Nm[k]).norm() * 1e3;
+    sum_p += dp * dp;
+    sum_a += da * da;
+    sum_t += dt * dt;
+    e.max_mm = std::max(e.max_mm, dp);
+    e.max_axis_rad = std::max(e.max_axis_rad, da);
+    if (run.status[k] != ref.status[k]) ++e.status_mismatch_ticks;
+    if (run.iterations[k] != ref.iterations[k]) ++e.iteration_mismatch_ticks;
+  }
+  const double nn = std::max<double>(1.0, static_cast<double>(n));
+  e.rms_mm = std::sqrt(sum_p / nn);
+  e.rms_axis_rad = std::sqrt(sum_a / nn);
+  e.rms_torque_mNm = std::sqrt(sum_t / nn);
+  e.finite = run.finite && std::isfinite(e.rms_mm);
+  if (!e.finite) {
+    e.rms_mm = e.max_mm = e.rms_axis_rad = e.max_axis_rad = kNaN;
+  }
+  return e;
+}
+
+// the test ClosedLoop's loader applies (sim/closed_loop.cc)
+bool divides_servo_period(double step_s, double period_s) {
+  const double n = std::round(period_s / step_s);
+  return n >= 1.0 && std::abs(n * step_s - period_s) <= 1e-9 * period_s;
+}
+
+bool same_step(double a, double b) {
+  return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b));
+}
+
+const char* const kColours[] = {"#1f77b4", "#d62728", "#2ca02c"};
+
+const char* colour_of(Integrator i) {
+  return kColours[static_cast<int>(i)];
+}
+
+}  // namespace
+
+const char* integrator_name(Integrator i) {
+  switch (i) {
+    case Integrator::kEuler: return "euler";
+    case Integrator::kImplicit: return "implicit";
+    case Integrator::kRk4: return "rk4";
+  }
+  return "unknown";
+}
+
+bool parse_integrator(const std::string& name, Integrator* out) {
+  for (Integrator i :
+       {Integrator::kEuler, Integrator::kImplicit, Integrator::kRk4}) {
+    if (name == integrator_name(i)) {
+      *out = i;
+      return true;
+    }
+  }
+  return false;
+}
+
+OrderFit fit_order(const std::vector<double>& steps_s,
+                   const std::vector<double>& errors) {
+  OrderFit f;
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < steps_s.size() && i < errors.size(); ++i) {
+    if (!(steps_s[i] > 0.0) || !(errors[i] > 0.0) ||
+        !std::isfinite(errors[i])) {
+      continue;
+    }
+    const double x = std::log10(steps_s[i]);
+    const double y = std::log10(errors[i]);
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+    ++n;
+    f.steps_used_s.push_back(steps_s[i]);
+  }
+  f.points = n;
+  const double den = n * sxx - sx * sx;
+  if (n < 2 || den <= 0.0) {
+    f.order = f.log10_coefficient = kNaN;
+    return f;
+  }
+  f.order = (n * sxy - sx * sy) / den;
+  f.log10_coefficient = (sy - f.order * sx) / n;
+  return f;
+}
+
+std::vector<bool> pareto_front(const std::vector<double>& x,
+                               const std::vector<double>& y) {
+  const std::size_t n = std::min(x.size(), y.size());
+  std::vector<bool> front(n, false);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(x[i]) || !std::isfinite(y[i])) continue;
+    bool dominated = false;
+    for (std::size_t j = 0; j < n && !dominated; ++j) {
+      if (j == i || !std::isfinite(x[j]) || !std::isfinite(y[j])) continue;
+      dominated = x[j] <= x[i] && y[j] <= y[i] && (x[j] < x[i] || y[j] < y[i]);
+    }
+    front[i] = !dominated;
+  }
+  return front;
+}
+
+PrecisionResult run_precision_study(const PrecisionOptions& o) {
+  const auto study_start = Clock::now();
+  PrecisionResult r;
+  r.scene = o.scene;
+  r.duration_s = o.duration_s;
+
+  // the scene's own setting, and every check before the first run: a loop
+  // built for each step of the ladder (the loader refuses a step that does
+  // not divide T, naming both)
+  {
+    ClosedLoop probe(o.scene, o.overrides);
+    r.servo_period_s = probe.controller_params().servo_period_s;
+    r.default_step_s = probe.model()->opt.timestep;
+    switch (probe.model()->opt.integrator) {
+      case mjINT_RK4: r.default_integrator = Integrator::kRk4; break;
+      case mjINT_IMPLICIT: r.default_integrator = Integrator::kImplicit; break;
+      default: r.default_integrator = Integrator::kEuler; break;
+    }
+    for (const ScriptSegment& seg : probe.script().segments()) {
+      if (seg.t0_s < o.duration_s) r.segments.push_back(seg);
+    }
+    const double script_s = probe.config().number("duration_s");
+    if (!(o.duration_s > 0.0) || o.duration_s > script_s + 1e-12) {
+      throw SimError(o.scene + ": the study's duration (" +
+                     exact(o.duration_s) + " s) must be > 0 and at most the "
+                     "case's duration_s (" + exact(script_s) + " s)");
+    }
+  }
+  r.ticks = static_cast<int>(std::llround(o.duration_s / r.servo_period_s));
+  if (r.ticks < 1) throw SimError("the study's duration is under one servo tick");
+  if (o.integrators.empty()) throw SimError("no integrator to study");
+  if (!(o.reference_step_s > 0.0) ||
+      !(o.reference_check_step_s > o.reference_step_s)) {
+    throw SimError("the reference step must be > 0 and below the check step");
+  }
+
+  // the ladder per integrator, largest step first, the default added
+  struct Setting {
+    Integrator integrator;
+    double step_s;
+  };
+  std::vector<Setting> settings;
+  for (Integrator i : o.integrators) {
+    std::vector<double> steps = o.steps_s;
+    if (i == r.default_integrator &&
+        std::none_of(steps.begin(), steps.end(), [&](double h) {
+          return same_step(h, r.default_step_s);
+        })) {
+      steps.push_back(r.default_step_s);
+    }
+    std::sort(steps.begin(), steps.end(), std::greater<double>());
+    steps.erase(std::unique(steps.begin(), steps.end(), same_step), steps.end());
+    for (double h : steps) {
+      if (!(h > o.reference_step_s)) {
+        throw SimError("the ladder's step " + exact(h) +
+                       " s is not above the reference step " +
+                       exact(o.reference_step_s) + " s");
+      }
+      settings.push_back({i, h});
+    }
+  }
+  for (const Setting& s : settings) {
+    if (!divides_servo_period(s.step_s, r.servo_period_s)) {
+      throw SimError("the physics step " + exact(s.step_s) +
+                     " s does not divide the servo period " +
+                     exact(r.servo_period_s) + " s");
+    }
+  }
+  for (double h : {o.reference_step_s, o.reference_check_step_s}) {
+    if (!divides_servo_period(h, r.servo_period_s)) {
+      throw SimError("the reference step " + exact(h) +
+                     " s does not divide the servo period " +
+                     exact(r.servo_period_s) + " s");
+    }
+  }
+
+  // the two references, side by side (each loop has its own thread and
+  // finds its hand through a thread-local pointer)
+  Trajectory ref, ref_check;
+  std::exception_ptr failure;
+  std::thread check_thread([&] {
+    try {
+      ref_check = run_setting(o, Integrator::kRk4, o.reference_check_step_s,
+                              r.ticks, 0.0, 1);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  });
+  try {
+    ref = run_setting(o, Integrator::kRk4, o.reference_step_s, r.ticks, 0.0, 1);
+  } catch (...) {
+    check_thread.join();
+    throw;
+  }
+  check_thread.join();
+  if (failure) std::rethrow_exception(failure);
+  if (!ref.finite) {
+    throw SimError(o.scene + ": the reference run blew up (MuJoCo warnings: " +
+                   std::to_string(ref.mujoco_warnings) + ")");
+  }
+  r.reference.step_s = o.reference_step_s;
+  r.reference.check_step_s = o.reference_check_step_s;
+  r.reference.wall_time_s = ref.wall_time_s;
+  r.reference.check_wall_time_s = ref_check.wall_time_s;
+  r.reference.self_error = compare(ref_check, ref);
+  r.floor_mm = kFloorFactor * r.reference.self_error.rms_mm;
+
+  // the ladder, one run at a time, so that the timings do not compete
+  const double simulated_s = r.ticks * r.servo_period_s;
+  for (const Setting& s : settings) {
+    const Trajectory tr = run_setting(o, s.integrator, s.step_s, r.ticks,
+                                      o.min_timing_s, o.max_repeats);
+    PrecisionRow row;
+    row.integrator = s.integrator;
+    row.step_s = s.step_s;
+    row.substeps = tr.substeps;
+    row.error = compare(tr, ref);
+    row.wall_time_s = tr.wall_time_s;
+    row.cpu_time_s = tr.cpu_time_s;
+    row.repeats = tr.repeats;
+    row.steps_per_s =
+        static_cast<double>(r.ticks) * tr.substeps / std::max(tr.wall_time_s, 1e-12);
+    row.realtime_factor = simulated_s / std::max(tr.wall_time_s, 1e-12);
+    row.is_default = s.integrator == r.default_integrator &&
+                     same_step(s.step_s, r.default_step_s);
+    row.mujoco_warnings = tr.mujoco_warnings;
+    row.local_order = kNaN;
+    r.rows.push_back(row);
+  }
+
+  // local orders, and the fitted order over the rungs above the floor
+  for (Integrator i : o.integrators) {
+    std::vector<double> hs, es;
+    const PrecisionRow* prev = nullptr;
+    for (PrecisionRow& row : r.rows) {
+      if (row.integrator != i) continue;
+      if (prev != nullptr && row.error.finite && prev->error.finite &&
+          row.error.rms_mm > 0.0 && prev->error.rms_mm > 0.0) {
+        row.local_order = std::log(prev->error.rms_mm / row.error.rms_mm) /
+                          std::log(prev->step_s / row.step_s);
+      }
+      prev = &row;
+      row.used_in_fit = row.error.finite && row.error.rms_mm > r.floor_mm;
+      if (row.used_in_fit) {
+        hs.push_back(row.step_s);
+        es.push_back(row.error.rms_mm);
+      }
+    }
+    OrderFit fit = fit_order(hs, es);
+    fit.integrator = i;
+    r.fits.push_back(fit);
+  }
+
+  std::vector<double> wall, cpu, err;
+  for (const PrecisionRow& row : r.rows) {
+    wall.push_back(row.wall_time_s);
+    cpu.push_back(row.cpu_time_s);
+    err.push_back(row.error.finite ? row.error.rms_mm : kNaN);
+  }
+  const std::vector<bool> front = pareto_front(wall, err);
+  const std::vector<bool> front_cpu = pareto_front(cpu, err);
+  for (std::size_t k = 0; k < r.rows.size(); ++k) {
+    r.rows[k].on_front = front[k];
+    r.rows[k].on_front_cpu = front_cpu[k];
+  }
+
+  r.study_wall_time_s =
+      std::chrono::duration<double>(Clock::now() - study_start).count();
+  return r;
+}
+
+std::string precision_csv(const PrecisionResult& r) {
+  std::string s =
+      "integrator,h_s,substeps_per_tick,rms_error_mm,max_error_mm,"
+      "rms_axis_error_rad,max_axis_error_rad,rms_torque_diff_mNm,"
+      "status_mismatch_ticks,iteration_mismatch_ticks,wall_time_s,cpu_time_s,"
+      "repeats,steps_per_s,realtime_factor,local_order,used_in_fit,on_front,"
+      "on_front_cpu,is_default,finite,mujoco_warnings\n";
+  char buf[512];
+  for (const PrecisionRow& row : r.rows) {
+    const TrajectoryError& e = row.error;
+    std::snprintf(buf, sizeof buf,
+                  "%s,%.9g,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%.9g,%.9g,%d,%.9g,"
+                  "%.9g,%.9g,%d,%d,%d,%d,%d,%d\n",
+                  integrator_name(row.integrator), row.step_s, row.substeps,
+                  e.rms_mm, e.max_mm, e.rms_axis_rad, e.max_axis_rad,
+                  e.rms_torque_mNm, e.status_mismatch_ticks,
+                  e.iteration_mismatch_ticks, row.wall_time_s, row.cpu_time_s,
+                  row.repeats, row.steps_per_s, row.realtime_factor,
+                  row.local_order, row.used_in_fit ? 1 : 0,
+                  row.on_front ? 1 : 0, row.on_front_cpu ? 1 : 0,
+                  row.is_default ? 1 : 0, e.finite ? 1 : 0,
+                  row.mujoco_warnings);
+    s += buf;
+  }
+  return s;
+}
+
+Chart precision_chart(const PrecisionResult& r) {
+  Chart c;
+  char title[160];
+  // centred on the plot area, so kept short
+  std::snprintf(title, sizeof title, "work-precision, %.3g s, T = %.3g ms",
+                r.duration_s, r.servo_period_s * 1e3);
+  c.title = title;
+  c.width_px = 820;
+  c.height_px = 480;
+  c.x = {"wall time of the run (s)", true};
+  c.y = {"RMS wrist-centre error vs RK4 reference (mm)", true};
+  for (const OrderFit& f : r.fits) {
+    ChartSeries s;
+    s.label = integrator_name(f.integrator);
+    s.color = colour_of(f.integrator);
+    for (const PrecisionRow& row : r.rows) {
+      if (row.integrator != f.integrator || !row.error.finite) continue;
+      s.x.push_back(row.wall_time_s);
+      s.y.push_back(row.error.rms_mm);
+    }
+    c.series.push_back(s);
+  }
+  for (const PrecisionRow& row : r.rows) {
+    if (!row.is_default || !row.error.finite) continue;
+    ChartSeries s;
+    char label[96];
+    std::snprintf(label, sizeof label, "default (%s, h = %.3g ms)",
+                  integrator_name(row.integrator), row.step_s * 1e3);
+    s.label = label;
+    s.color = "#000000";
+    s.line = false;
+    s.x = {row.wall_time_s};
+    s.y = {row.error.rms_mm};
+    c.series.push_back(s);
+  }
+  // the reference's own error, across the chart
+  if (r.reference.self_error.rms_mm > 0.0 && !r.rows.empty()) {
+    double lo = r.rows.front().wall_time_s, hi = lo;
+    for (const PrecisionRow& row : r.rows) {
+      lo = std::min(lo, row.wall_time_s);
+      hi = std::max(hi, row.wall_time_s);
+    }
+    ChartSeries s;
+    s.label = "reference self-error (RK4 " +
+              exact(r.reference.check_step_s * 1e6) + " us vs " +
+              exact(r.reference.step_s * 1e6) + " us)";
+    s.color = "#7f7f7f";
+    s.markers = false;
+    s.dashed = true;
+    s.x = {lo, hi};
+    s.y = {r.reference.self_error.rms_mm, r.reference.self_error.rms_mm};
+    c.series.push_back(s);
+  }
+  return c;
+}
+
+Chart precision_order_chart(const PrecisionResult& r) {
+  Chart c;
+  c.title = "error against the physics step";
+  c.width_px = 820;
+  c.height_px = 480;
+  c.x = {"physics step h (s)", true};
+  c.y = {"RMS wrist-centre error vs RK4 reference (mm)", true};
+  for (const OrderFit& f : r.fits) {
+    ChartSeries s;
+    s.color = colour_of(f.integrator);
+    s.label = integrator_name(f.integrator);
+    for (const PrecisionRow& row : r.rows) {
+      if (row.integrator != f.integrator || !row.error.finite) continue;
+      s.x.push_back(row.step_s);
+      s.y.push_back(row.error.rms_mm);
+    }
+    c.series.push_back(s);
+    if (f.points >= 2) {
+      ChartSeries line;
+      char label[96];
+      std::snprintf(label, sizeof label, "%s fit, order %.2f",
+                    integrator_name(f.integrator), f.order);
+      line.label = label;
+      line.color = colour_of(f.integrator);
+      line.markers = false;
+      line.dashed = true;
+      const auto [lo, hi] =
+          std::minmax_element(f.steps_used_s.begin(), f.steps_used_s.end());
+      for (double h : {*lo, *hi}) {
+        line.x.push_back(h);
+        line.y.push_back(std::pow(10.0, f.log10_coefficient) *
+                         std::pow(h, f.order));
+      }
+      c.series.push_back(line);
+    }
+  }
+  if (r.floor_mm > 0.0 && !r.rows.empty()) {
+    ChartSeries s;
+    s.label = "fit floor (10 x reference self-error)";
+    s.color = "#7f7f7f";
+    s.markers = false;
+    s.dashed = true;
+    double lo = r.rows.front().step_s, hi = lo;
+    for (const PrecisionRow& row : r.rows) {
+      lo = std::min(lo, row.step_s);
+      hi = std::max(hi, row.step_s);
+    }
+    s.x = {lo, hi};
+    s.y = {r.floor_mm, r.floor_mm};
+    c.series.push_back(s);
+  }
+  return c;
+}
+
+}  // namespace vmh::sim

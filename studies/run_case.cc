@@ -1,0 +1,257 @@
+#include "studies/run_case.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "controller/device_frame.h"
+#include "report/output_file.h"
+#include "report/parallel.h"
+#include "studies/plot_svg.h"
+
+namespace vmh::sim {
+namespace fs = std::filesystem;
+namespace {
+
+
+void put(std::string* s, double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g,", x);
+  *s += buf;
+}
+
+std::string trace_csv(const std::vector<TraceRow>& rows, const ClosedLoop& loop) {
+  const int dof = loop.controller().mechanism().dof();
+  std::string s;
+  const std::vector<std::string> cols = trace_columns(dof);
+  for (std::size_t i = 0; i < cols.size(); ++i) {
+    s += cols[i] + (i + 1 < cols.size() ? "," : "\n");
+  }
+  const auto& segs = loop.script().segments();
+  s.reserve(rows.size() * 900);
+  for (const TraceRow& r : rows) {
+    const ControlOutput& o = r.out;
+    put(&s, r.t_s);
+    for (int i = 0; i < 6; ++i) put(&s, r.q_dh[i]);
+    for (int i = 0; i < 3; ++i) put(&s, o.p_rm_mm[i]);
+    for (int i = 0; i < 3; ++i) put(&s, o.axis_rm[i]);
+    for (int i = 0; i < dof; ++i) put(&s, i < o.theta_v.size() ? o.theta_v[i] : 0.0);
+    for (int i = 0; i < dof; ++i) put(&s, i < o.theta_r.size() ? o.theta_r[i] : 0.0);
+    for (int i = 0; i < 3; ++i) put(&s, o.x_v_mm[i]);
+    for (int i = 0; i < 3; ++i) put(&s, o.x_r_mm[i]);
+    for (int i = 0; i < 6; ++i) put(&s, o.e[i]);
+    for (int i = 0; i < 6; ++i) put(&s, o.f_motion[i]);
+    for (int i = 0; i < 3; ++i) put(&s, o.force_device_N[i]);
+    for (int i = 0; i < 3; ++i) put(&s, o.tau_motor_Nm[i]);
+    for (int i = 0; i < 3; ++i) put(&s, r.motor_torque_Nm[i]);
+    for (int i = 0; i < 3; ++i) put(&s, r.hand_target.p_mm[i]);
+    for (int i = 0; i < 3; ++i) put(&s, r.hand_force_N[i]);
+    put(&s, r.d_path_mm);
+    s += std::to_string(o.status) + ",";
+    s += segs[static_cast<std::size_t>(r.segment)].name + "\n";
+  }
+  return s;
+}
+
+nlohmann::json claim_json(const Claim& c) {
+  return {{"name", c.name},         {"statement", c.statement},
+          {"window", c.window},     {"value", c.value},
+          {"comparison", c.comparison}, {"threshold", c.threshold},
+          {"unit", c.unit},         {"samples", c.samples},
+          {"mean_path_distance_mm", c.mean_path_distance_mm},
+          {"pass", c.pass}};
+}
+
+}  // namespace
+
+const std::vector<CaseEntry>& thesis_cases() {
+  static const std::vector<CaseEntry> cases = {
+      {"case1", "cases/case1.xml"}, {"case2", "cases/case2.xml"},
+      {"case3", "cases/case3.xml"}, {"case4", "cases/case4.xml"},
+      {"case5", "cases/case5.xml"}, {"case6", "cases/case6.xml"},
+  };
+  return cases;
+}
+
+std::string models_dir() {
+  const char* env = std::getenv("VMH_MODELS_DIR");
+  if (env != nullptr && env[0] != '\0') return env;
+  return VMH_DEFAULT_MODELS_DIR;
+}
+
+std::string resolve_scene(const std::string& case_or_path, std::string* name) {
+  for (const CaseEntry& c : thesis_cases()) {
+    if (case_or_path == c.name) {
+      *name = c.name;
+      return (fs::path(models_dir()) / c.scene).string();
+    }
+  }
+  if (fs::exists(case_or_path)) {
+    *name = fs::path(case_or_path).stem().string();
+    return case_or_path;
+  }
+  std::string known;
+  for (const CaseEntry& c : thesis_cases()) known += std::string(" ") + c.name;
+  throw SimError("'" + case_or_path +
+                 "' is neither a case (" + known.substr(1) +
+                 ") nor an existing scene file");
+}
+
+std::vector<std::string> trace_columns(int vm_dof) {
+  std::vector<std::string> c = {"t_s"};
+  for (int i = 1; i <= 6; ++i) c.push_back("q" + std::to_string(i) + "_rad");
+  for (const char* a : {"x", "y", "z"}) c.push_back(std::string("p_") + a + "_mm");
+  for (const char* a : {"x", "y", "z"}) c.push_back(std::string("a_") + a);
+  for (const char* v : {"theta_v_", "theta_r_"}) {
+    for (int i = 1; i <= vm_dof; ++i) c.push_back(v + std::to_string(i));
+  }
+  for (const char* v : {"xv_", "xr_"}) {
+    for (const char* a : {"x", "y", "z"}) c.push_back(std::string(v) + a + "_mm");
+  }
+  for (int i = 1; i <= 6; ++i) {
+    c.push_back("e_" + std::to_string(i) + (i <= 3 ? "_mm" : "_rad"));
+  }
+  for (int i = 1; i <= 6; ++i) {
+    c.push_back("f_" + std::to_string(i) + (i <= 3 ? "_N" : "_Nmm"));
+  }
+  for (const char* a : {"x", "y", "z"}) c.push_back(std::string("F_") + a + "_N");
+  for (int i = 1; i <= 3; ++i) c.push_back("tau_" + std::to_string(i) + "_Nm");
+  for (int i = 1; i <= 3; ++i) {
+    c.push_back("tau_applied_" + std::to_string(i) + "_Nm");
+  }
+  for (const char* a : {"x", "y", "z"}) c.push_back(std::string("hand_") + a + "_mm");
+  for (const char* a : {"x", "y", "z"}) {
+    c.push_back(std::string("hand_F_") + a + "_N");
+  }
+  c.push_back("d_path_mm");
+  c.push_back("status");
+  c.push_back("phase");
+  return c;
+}
+
+CaseResult run_case(const std::string& name, const std::string& scene,
+                    const std::vector<std::string>& overrides,
+                    const std::string& out_dir) {
+  CaseResult result;
+  result.name = name;
+  result.scene = scene;
+
+  ClosedLoop loop(scene, overrides);
+  const int thesis_case = static_cast<int>(loop.config().number("thesis_case"));
+  if (auto ref = reference_params(thesis_case, loop.controller_params())) {
+    loop.set_reference(*ref);
+  }
+  // with servo jitter the number of ticks is not known ahead: run until the
+  // simulated time is up
+  std::vector<TraceRow> rows;
+  rows.reserve(static_cast<std::size_t>(loop.ticks_per_run()));
+
+  const auto start = std::chrono::steady_clock::now();
+  while (!loop.finished()) {
+    rows.emplace_back();
+    loop.tick(&rows.back());
+  }
+  const auto stop = std::chrono::steady_clock::now();
+  result.wall_time_s = std::chrono::duration<double>(stop - start).count();
+  result.simulated_s = loop.time_s();
+
+  result.metrics = run_metrics(rows, loop);
+  result.claims = evaluate_claims(thesis_case, rows, loop);
+  for (const Claim& c : result.claims) result.all_claims_pass &= c.pass;
+
+  // the summary
+  const RunMetrics& m = result.metrics;
+  const mjModel* model = loop.model();
+  nlohmann::json params = nlohmann::json::object();
+  for (const FieldSpec& f : case_fields()) {
+    nlohmann::json v;
+    if (f.is_text) {
+      v = loop.config().text(f.name);
+    } else if (f.size == 1) {
+      v = loop.config().number(f.name);
+    } else {
+      v = loop.config().numbers(f.name);
+    }
+    params[f.name] = {{"value", v},
+                      {"unit", f.unit},
+                      {"source", value_source_name(loop.config().source_of(f.name))}};
+  }
+  nlohmann::json warnings = nlohmann::json::object();
+  int warning_total = 0;
+  for (int i = 0; i < mjNWARNING; ++i) {
+    const int n = loop.data()->warning[i].number;
+    warning_total += n;
+    if (n > 0) warnings[std::to_string(i)] = n;
+  }
+  nlohmann::json claims = nlohmann::json::array();
+  for (const Claim& c : result.claims) claims.push_back(claim_json(c));
+  static const char* const kIntegrators[] = {"Euler", "RK4", "implicit"};
+  result.summary = {
+      {"case", name},
+      {"scene", scene},
+      {"thesis_case", thesis_case},
+      {"simulated_s", result.simulated_s},
+      {"wall_time_s", result.wall_time_s},
+      {"realtime_factor", result.simulated_s / std::max(result.wall_time_s, 1e-9)},
+      {"physics",
+       {{"step_s", model->opt.timestep},
+        {"substeps_per_tick", loop.substeps()},
+        {"integrator", kIntegrators[std::clamp(model->opt.integrator, 0, 2)]},
+        {"servo_period_s", loop.controller_params().servo_period_s},
+        {"gravity_m_s2", {model->opt.gravity[0], model->opt.gravity[1], model->opt.gravity[2]}}}},
+      {"parameters", params},
+      {"metrics",
+       {{"ticks", m.ticks},
+        {"rms_path_error_mm", m.rms_path_error_mm},
+        {"max_path_error_mm", m.max_path_error_mm},
+        {"rms_xv_error_mm", m.rms_xv_error_mm},
+        {"mean_force_N", m.mean_force_N},
+        {"rms_force_N", m.rms_force_N},
+        {"max_force_N", m.max_force_N},
+        {"time_on_path_s", m.time_on_path_s},
+        {"on_path_within_mm", kOnPathMm},
+        {"force_saturated_ticks", m.force_saturated_ticks},
+        {"torque_saturated_ticks", m.torque_saturated_ticks},
+        {"fault_ticks", m.fault_ticks},
+        {"placement_not_converged_ticks", m.placement_not_converged_ticks},
+        {"max_placement_iterations", m.max_placement_iterations}}},
+      {"mujoco_warnings", warning_total},
+      {"mujoco_warning_kinds", warnings},
+      {"claims", claims},
+      {"all_claims_pass", result.all_claims_pass},
+  };
+
+  if (!out_dir.empty()) {
+    const fs::path dir = fs::path(out_dir) / name;
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw SimError(dir.string() + ": " + ec.message());
+    write_file_atomically((dir / "trace.csv").string(), trace_csv(rows, loop));
+    write_file_atomically((dir / "summary.json").string(), result.summary.dump(2) + "\n");
+    write_file_atomically((dir / "views.svg").string(), views_svg(rows, loop));
+    write_file_atomically((dir / "history.svg").string(), history_svg(rows, loop));
+  }
+  return result;
+}
+
+void run_cases(std::vector<CaseJob>* jobs,
+               const std::vector<std::string>& overrides,
+               const std::string& out_dir, int threads) {
+  parallel_for(jobs->size(), threads > 0 ? threads : core_count(),
+               [&](std::size_t i) {
+                 CaseJob& job = (*jobs)[i];
+                 try {
+                   job.result = run_case(job.name, job.scene, overrides, out_dir);
+                 } catch (const SimError& e) {
+                   job.error = e.what();
+                   job.bad_input = true;
+                 } catch (const std::exception& e) {
+                   job.error = e.what();
+                 }
+               });
+}
+
+}  // namespace vmh::sim

@@ -1,0 +1,72 @@
+// Runs a case from start to end and writes its outputs: DIR/<case>/trace.csv
+// (one row per servo tick), DIR/<case>/summary.json (metrics and the
+// thesis's claims), and the plots views.svg and history.svg (plot_svg.h).
+// Each is written to a temporary name and renamed, so a failed run leaves
+// nothing half-written. README.md documents the formats.
+#ifndef VMHAPTICS_STUDIES_RUN_CASE_H_
+#define VMHAPTICS_STUDIES_RUN_CASE_H_
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+#include "studies/claims.h"
+
+namespace vmh::sim {
+
+// The thesis's six cases, in order: name and scene file under the models
+// directory. Adding a case is one line here and one file in models/cases/.
+struct CaseEntry {
+  const char* name;
+  const char* scene;
+};
+const std::vector<CaseEntry>& thesis_cases();
+
+// The models directory: $VMH_MODELS_DIR if set, else the source tree's.
+std::string models_dir();
+
+// A case name ("case1") to its scene path, or a path to itself. Throws
+// SimError for a name that is neither a known case nor an existing file.
+std::string resolve_scene(const std::string& case_or_path, std::string* name);
+
+struct CaseResult {
+  std::string name;
+  std::string scene;
+  nlohmann::json summary;  // what summary.json holds
+  RunMetrics metrics;
+  std::vector<Claim> claims;
+  double wall_time_s = 0.0;
+  double simulated_s = 0.0;
+  bool all_claims_pass = true;
+};
+
+// Runs `scene` (with `overrides`) for its duration and, if out_dir is not
+// empty, writes out_dir/<name>/{trace.csv, summary.json, views.svg,
+// history.svg}. Throws SimError on bad input (before anything is written).
+CaseResult run_case(const std::string& name, const std::string& scene,
+                    const std::vector<std::string>& overrides,
+                    const std::string& out_dir);
+
+// One run of run_cases(): the case's name and scene, and what came of it.
+struct CaseJob {
+  std::string name;
+  std::string scene;
+  CaseResult result;   // filled when error is empty
+  std::string error;   // the exception's message, if the run threw
+  bool bad_input = false;  // the error was a SimError (bad scene or field)
+};
+
+// Runs every job through run_case() on `threads` threads (0: one per core,
+// never more than there are jobs), each run in its own thread with its own
+// model and data. Exceptions are caught per job and recorded in it.
+void run_cases(std::vector<CaseJob>* jobs,
+               const std::vector<std::string>& overrides,
+               const std::string& out_dir, int threads);
+
+// The trace's column names, in order.
+std::vector<std::string> trace_columns(int vm_dof);
+
+}  // namespace vmh::sim
+
+#endif  // VMHAPTICS_STUDIES_RUN_CASE_H_

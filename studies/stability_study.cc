@@ -1,0 +1,602 @@
+#include "studies/stability_study.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+
+#include "report/parallel.h"
+#include "report/svg_chart.h"
+
+namespace vmh::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string str(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// "--option: what (got v)"
+[[noreturn]] void bad(const std::string& option, const std::string& what,
+                      double got) {
+  throw SimError(option + ": " + what + " (got " + str(got) + ")");
+}
+
+// The plant over one servo period with the force F held:
+//   [x, v]_{k+1} = A [x, v]_k + Bf F.
+struct PlantStep {
+  Eigen::Matrix2d A;
+  Eigen::Vector2d Bf;
+};
+
+// m x'' + b x' = F solved exactly over T. With z = bT/m and e = exp(-z):
+//   v(T) = e v + (1 - e)/b F
+//   x(T) = x + (1 - e) m/b v + (T - (1 - e) m/b) F/b,
+// written with phi1 = (1 - e) m/b = T (1 - e)/z and
+// (T - phi1) m/b = T² g(z), g(z) = (z - 1 + e)/z², each evaluated without
+// cancellation for small z (and so b = 0, where phi1 = T, g = 1/2).
+PlantStep exact_zoh(const StabilityParams& p) {
+  const double m = p.mass_kg, T = p.servo_period_s;
+  const double z = p.damping_Ns_per_m * T / m;
+  const double e = std::exp(-z);
+  const double phi1_over_T = z < 1e-8 ? 1.0 - 0.5 * z : -std::expm1(-z) / z;
+  const double g = z < 1e-3
+                       ? 0.5 - z / 6.0 + z * z / 24.0 - z * z * z / 120.0
+                       : (z + std::expm1(-z)) / (z * z);
+  PlantStep s;
+  s.A << 1.0, T * phi1_over_T, 0.0, e;
+  s.Bf << T * T * g / m, T * phi1_over_T / m;
+  return s;
+}
+
+// N steps of MuJoCo's Euler integrator with the joint damping implicit
+// (mj_Euler: qacc solved with M + h D): v' = (m v + h F)/(m + h b), then
+// x' = x + h v'.
+PlantStep mujoco_euler(const StabilityParams& p) {
+  const double m = p.mass_kg, h = p.physics_step_s;
+  const double c = m / (m + h * p.damping_Ns_per_m);
+  Eigen::Matrix2d As;
+  As << 1.0, h * c, 0.0, c;
+  const Eigen::Vector2d Bs(h * h / (m + h * p.damping_Ns_per_m),
+                           h / (m + h * p.damping_Ns_per_m));
+  PlantStep s;
+  s.A.setIdentity();
+  s.Bf.setZero();
+  for (int i = 0, n = steps_per_tick(p); i < n; ++i) {
+    s.A = As * s.A;
+    s.Bf = As * s.Bf + Bs;
+  }
+  return s;
+}
+
+}  // namespace
+
+void validate(const StabilityParams& p) {
+  if (!std::isfinite(p.mass_kg) || !(p.mass_kg > 0.0)) {
+    bad("--mass", "the slider's mass must be > 0 kg", p.mass_kg);
+  }
+  if (!std::isfinite(p.damping_Ns_per_m) || p.damping_Ns_per_m < 0.0) {
+    bad("--damping", "the physical damping b must be >= 0 N s/m",
+        p.damping_Ns_per_m);
+  }
+  if (!std::isfinite(p.servo_period_s) || !(p.servo_period_s > 0.0)) {
+    bad("--servo-period", "the servo period T must be > 0 s",
+        p.servo_period_s);
+  }
+  if (!std::isfinite(p.virtual_damping_Ns_per_m) ||
+      p.virtual_damping_Ns_per_m < 0.0) {
+    bad("--virtual-damping", "the virtual damping B must be >= 0 N s/m",
+        p.virtual_damping_Ns_per_m);
+  }
+  if (!(p.damping_Ns_per_m + p.virtual_damping_Ns_per_m > 0.0)) {
+    throw SimError(
+        "--damping, --virtual-damping: b + B must be > 0 N s/m (with no "
+        "damping at all no stiffness is stable, K_crit = 0)");
+  }
+  if (p.delay_ticks < 0 || p.delay_ticks > kStudyMaxDelayTicks) {
+    bad("--delay-ticks",
+        "the delay must be 0.." + std::to_string(kStudyMaxDelayTicks) + " ticks",
+        p.delay_ticks);
+  }
+  const double h = p.physics_step_s, T = p.servo_period_s;
+  if (!std::isfinite(h) || !(h > 0.0) || h > T * (1.0 + 1e-9)) {
+    bad("--physics-step",
+        "the physics step h must be > 0 s and at most the servo period " +
+            str(T) + " s",
+        h);
+  }
+  const double ratio = T / h;
+  if (ratio > kMaxStepsPerTick + 0.5) {
+    throw SimError("--physics-step: at most " +
+                   std::to_string(kMaxStepsPerTick) +
+                   " physics steps per servo period (T/h = " + str(ratio) +
+                   ")");
+  }
+  if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio) {
+    throw SimError("--physics-step: the servo period T = " + str(T) +
+                   " s must be a whole multiple of the physics step h = " +
+                   str(h) + " s (T/h = " + str(ratio) + ")");
+  }
+}
+
+int steps_per_tick(const StabilityParams& p) {
+  return static_cast<int>(std::lround(p.servo_period_s / p.physics_step_s));
+}
+
+// ---------------------------------------------------------------- theory
+
+double k_bound_gil_N_per_m(const StabilityParams& p) {
+  const double T = p.servo_period_s;
+  return (p.damping_Ns_per_m + p.virtual_damping_Ns_per_m) /
+         (0.5 * T + p.delay_ticks * T);
+}
+
+double k_passivity_N_per_m(const StabilityParams& p) {
+  return 2.0 * (p.damping_Ns_per_m - std::abs(p.virtual_damping_Ns_per_m)) /
+         p.servo_period_s;
+}
+
+Eigen::MatrixXd closed_loop_matrix(const StabilityParams& p, double k_N_per_m,
+                                   PlantModel plant) {
+  const PlantStep s =
+      plant == PlantModel::kExactZoh ? exact_zoh(p) : mujoco_euler(p);
+  const int n = p.delay_ticks;
+  const int dim = 3 + n;
+  const double BT = p.virtual_damping_Ns_per_m / p.servo_period_s;
+  // the force computed this tick from the state: u_k = -K x_k - B/T (x_k -
+  // x_{k-1})
+  // (or -K x_k - B v_k with the sampled velocity)
+  Eigen::RowVectorXd u_now = Eigen::RowVectorXd::Zero(dim);
+  if (p.velocity == VelocityEstimate::kSampled) {
+    u_now(0) = -k_N_per_m;
+    u_now(1) = -p.virtual_damping_Ns_per_m;
+  } else {
+    u_now(0) = -k_N_per_m - BT;
+    u_now(2) = BT;
+  }
+  // the force applied over this tick: u_k itself, or u_{k-n}
+  Eigen::RowVectorXd f = Eigen::RowVectorXd::Zero(dim);
+  if (n == 0) {
+    f = u_now;
+  } else {
+    f(3 + n - 1) = 1.0;
+  }
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(dim, dim);
+  M.block(0, 0, 2, 2) = s.A;
+  M.row(0) += s.Bf(0) * f;
+  M.row(1) += s.Bf(1) * f;
+  M(2, 0) = 1.0;  // x_{k-1} <- x_k
+  if (n > 0) {
+    M.row(3) = u_now;  // u_{k-1} <- u_k
+    for (int j = 1; j < n; ++j) M(3 + j, 3 + j - 1) = 1.0;
+  }
+  return M;
+}
+
+double spectral_radius(const StabilityParams& p, double k_N_per_m,
+                       PlantModel plant) {
+  const Eigen::MatrixXd M = closed_loop_matrix(p, k_N_per_m, plant);
+  Eigen::EigenSolver<Eigen::MatrixXd> es(M, false);
+  return es.eigenvalues().cwiseAbs().maxCoeff();
+}
+
+DiscreteKcrit k_crit_discrete(const StabilityParams& p, PlantModel plant,
+                              double rel_tol) {
+  validate(p);
+  DiscreteKcrit r;
+  auto unstable = [&](double k) {
+    ++r.iterations;
+    return spectral_radius(p, k, plant) >= 1.0;
+  };
+  const double guess = k_bound_gil_N_per_m(p);
+  // just above K = 0 the slider's free-position pole (z = 1) has moved
+  // inside by about K T / (b + B): stable unless the damping loop itself
+  // is not
+  double lo = 1e-6 * guess;
+  if (unstable(lo)) return r;
+  double hi = 2.0 * guess;
+  for (int i = 0; !unstable(hi); ++i) {
+    if (i == 60) throw std::runtime_error("k_crit_discrete: no unstable K");
+    lo = hi;
+    hi *= 2.0;
+  }
+  while ((hi - lo) > rel_tol * lo) {
+    const double mid = 0.5 * (lo + hi);
+    (unstable(mid) ? hi : lo) = mid;
+  }
+  r.k_crit_N_per_m = 0.5 * (lo + hi);
+  return r;
+}
+
+// ---------------------------------------------------------------- simulation
+
+std::string slider_model_path(const std::string& models_dir) {
+  return (std::filesystem::path(models_dir) / "slider" / "slider.xml")
+      .string();
+}
+
+SliderWall::SliderWall(const std::string& model_path,
+                       const StabilityParams& p)
+    : p_(p) {
+  validate(p_);
+  m_ = load_model(model_path);
+  mjModel* m = m_.get();
+  const int body = require_id(m, mjOBJ_BODY, "slider", model_path);
+  const int joint = require_id(m, mjOBJ_JOINT, "x", model_path);
+  const int motor = require_id(m, mjOBJ_ACTUATOR, "force", model_path);
+  if (m->nq != 1 || m->nv != 1 || m->nu != 1 ||
+      m->jnt_type[joint] != mjJNT_SLIDE || m->jnt_bodyid[joint] != body ||
+      m->actuator_trntype[motor] != mjTRN_JOINT ||
+      m->actuator_trnid[2 * motor] != joint ||
+      m->actuator_gear[6 * motor] != 1.0 || m->actuator_ctrllimited[motor] ||
+      m->actuator_forcelimited[motor] || m->dof_armature[0] != 0.0 ||
+      m->dof_frictionloss[0] != 0.0 || m->jnt_limited[joint]) {
+    throw SimError(model_path +
+                   ": not the study's slider (one free slide joint 'x' of "
+                   "body 'slider', no armature, friction or limit, and one "
+                   "unlimited motor 'force' on it with gear 1)");
+  }
+  // m: the body's mass, its (irrelevant to a slide joint, but positive)
+  // inertia scaled alike; b: the joint's damping; h: the step. Euler, as
+  // the testbed's scenes, whose implicit joint damping is what
+  // PlantModel::kMujocoEuler models.
+  const double scale = p_.mass_kg / m->body_mass[body];
+  m->body_mass[body] = p_.mass_kg;
+  for (int i = 0; i < 3; ++i) m->body_inertia[3 * body + i] *= scale;
+  m->dof_damping[0] = p_.damping_Ns_per_m;
+  m->opt.timestep = p_.physics_step_s;
+  m->opt.integrator = mjINT_EULER;
+  d_.reset(mj_makeData(m));
+  mj_setConst(m, d_.get());
+  steps_per_tick_ = steps_per_tick(p_);
+}
+
+int SliderWall::horizon_ticks(double k_N_per_m) const {
+  const double period_s =
+      2.0 * kPi * std::sqrt(p_.mass_kg / std::max(k_N_per_m, 1e-300));
+  const double ticks = kHorizonPeriods * period_s / p_.servo_period_s;
+  return static_cast<int>(
+      std::clamp(std::ceil(ticks), double{kMinHorizonTicks}, 1e7));
+}
+
+WallRun SliderWall::run(double k_N_per_m, int ticks,
+                        std::vector<double>* x_per_tick) {
+  if (ticks <= 0) ticks = horizon_ticks(k_N_per_m);
+  mjModel* m = m_.get();
+  mjData* d = d_.get();
+  mj_resetData(m, d);
+  const double x0 = kInitialDisplacement_m;
+  d->qpos[0] = x0;
+  mj_forward(m, d);
+
+  const double T = p_.servo_period_s;
+  const double B = p_.virtual_damping_Ns_per_m;
+  const int n = p_.delay_ticks;
+  std::vector<double> delay_line(static_cast<std::size_t>(n), 0.0);
+  std::size_t oldest = 0;
+  double x_prev = x0;
+
+  std::vector<double> xs;
+  xs.reserve(static_cast<std::size_t>(ticks) + 1);
+  WallRun r;
+  r.k_N_per_m = k_N_per_m;
+  for (int k = 0; k < ticks; ++k) {
+    const double x = d->qpos[0];
+    xs.push_back(x);
+    if (!std::isfinite(x) || std::abs(x) > kDivergedFactor * x0) {
+      r.diverged = true;
+      break;
+    }
+    // the controller's tick: sample, backward difference, wall force
+    const double v = p_.velocity == VelocityEstimate::kSampled
+                         ? d->qvel[0]
+                         : (x - x_prev) / T;
+    const double u = -k_N_per_m * x - B * v;
+    x_prev = x;
+    double f = u;
+    if (n > 0) {
+      f = delay_line[oldest];
+      delay_line[oldest] = u;
+      oldest = (oldest + 1) % delay_line.size();
+    }
+    // held over the period while the physics steps
+    d->ctrl[0] = f;
+    for (int j = 0; j < steps_per_tick_; ++j) mj_step(m, d);
+    ++r.ticks;
+  }
+  if (!r.diverged) xs.push_back(d->qpos[0]);
+  for (int i = 0; i < mjNWARNING; ++i) {
+    if (d->warning[i].number > 0) {
+      throw std::runtime_error(
+          "stability study: MuJoCo warning " + std::to_string(i) +
+          " during a run at K = " + str(k_N_per_m) + " N/m");
+    }
+  }
+  if (x_per_tick != nullptr) *x_per_tick = xs;
+
+  const std::size_t L = xs.size();
+  if (r.diverged) {
+    r.stable = false;
+    r.early_peak_m = x0;
+    r.late_peak_m = std::abs(xs.back());
+    r.growth_rate_per_s = std::log(r.late_peak_m / x0) /
+                          (static_cast<double>(std::max<std::size_t>(L, 2) - 1) * T);
+    return r;
+  }
+
+  // The envelope. For one oscillatory mode x_k = A rho^k cos(k theta + phi)
+  // the quantity Q_k = x_k² - x_{k-1} x_{k+1} equals A² sin²(theta) rho^{2k}
+  // exactly: a smooth exponential without the oscillation, so the sum of Q
+  // over a late window against an early one gives rho even when it is
+  // within 1e-6 of 1, where peaks of |x| sampled once a tick would be
+  // swamped by where the samples fall. (The sampled sequence of this linear
+  // loop is exactly that of a linear discrete system, whatever h is.)
+  // The loop's other modes, the backward difference's and the delay
+  // line's, are real or fast and die out within tens of ticks near K_crit;
+  // the early window starts a third of the way into the run (at least 100
+  // ticks), after them. Each window is one period of sqrt(K/m) long, at most
+  // a quarter of the run. If a window's sum is not positive (a mode at
+  // z = -1, where sin(theta) = 0), the sums of x² are used instead.
+  const double period_ticks =
+      2.0 * kPi * std::sqrt(p_.mass_kg / std::max(k_N_per_m, 1e-300)) / T;
+  const std::size_t W = static_cast<std::size_t>(std::clamp(
+      std::round(period_ticks), 10.0, std::floor(static_cast<double>(L) / 4.0)));
+  const std::size_t e0 = L / 3, e1 = e0 + W;  // early window [e0, e1)
+  const std::size_t l0 = L - 1 - W, l1 = L - 1;  // late window [l0, l1)
+  auto sum_q = [&](std::size_t a, std::size_t b) {
+    double s = 0.0;
+    for (std::size_t k = a; k < b; ++k) {
+      s += xs[k] * xs[k] - xs[k - 1] * xs[k + 1];
+    }
+    return s;
+  };
+  auto sum_x2 = [&](std::size_t a, std::size_t b) {
+    double s = 0.0;
+    for (std::size_t k = a; k < b; ++k) s += xs[k] * xs[k];
+    return s;
+  };
+  auto peak = [&](std::size_t a, std::size_t b) {
+    double s = 0.0;
+    for (std::size_t k = a; k < b; ++k) s = std::max(s, std::abs(xs[k]));
+    return s;
+  };
+  double early = sum_q(e0, e1), late = sum_q(l0, l1);
+  if (!(early > 0.0 && late > 0.0)) {
+    early = sum_x2(e0, e1);
+    late = sum_x2(l0, l1);
+  }
+  const double dk = static_cast<double>(l0) - static_cast<double>(e0);
+  // both sums go as rho^{2k}
+  r.growth_rate_per_s = std::log(late / early) / (2.0 * dk * T);
+  r.stable = late < early;
+  r.early_peak_m = peak(e0, e1);
+  r.late_peak_m = peak(l0, l1);
+  return r;
+}
+
+SimKcrit k_crit_simulated(SliderWall& wall, double k_guess_N_per_m,
+                          double rel_tol) {
+  SimKcrit r;
+  WallRun at_lo, at_hi;  // the bracket's runs
+  auto grows = [&](double k) {
+    const WallRun run = wall.run(k);
+    r.history.push_back(run);
+    ++r.runs;
+    r.physics_steps +=
+        static_cast<long long>(run.ticks) * steps_per_tick(wall.params());
+    (run.stable ? at_lo : at_hi) = run;
+    return !run.stable;
+  };
+  // a bracket around the guess, widened until it holds
+  double step = 1.03;
+  double lo = k_guess_N_per_m / step, hi = k_guess_N_per_m * step;
+  bool hi_known = false;
+  while (grows(lo)) {
+    hi = lo;
+    hi_known = true;
+    lo /= step;
+    step *= step;
+    if (lo < 1e-9 * k_guess_N_per_m) return r;  // no stable K found
+  }
+  if (!hi_known) {
+    while (!grows(hi)) {
+      lo = hi;
+      hi *= step;
+      step *= step;
+      if (hi > 1e9 * k_guess_N_per_m) {
+        throw std::runtime_error("k_crit_simulated: no unstable K found");
+      }
+    }
+  }
+  while (hi - lo > rel_tol * lo) {
+    const double mid = 0.5 * (lo + hi);
+    (grows(mid) ? hi : lo) = mid;
+  }
+  r.k_stable_N_per_m = lo;
+  r.k_unstable_N_per_m = hi;
+  // The growth rate is a smooth function of K (the log of the dominant
+  // eigenvalue's modulus, over T) measured to many digits, so its zero
+  // between the bracket's two runs is a far closer K_crit than the
+  // bracket's middle; the middle if a run diverged.
+  const double r_lo = at_lo.growth_rate_per_s, r_hi = at_hi.growth_rate_per_s;
+  if (!at_hi.diverged && r_lo < 0.0 && r_hi >= 0.0 && r_hi > r_lo) {
+    r.k_crit_N_per_m = lo + (hi - lo) * (-r_lo) / (r_hi - r_lo);
+    r.interpolated = true;
+  } else {
+    r.k_crit_N_per_m = 0.5 * (lo + hi);
+  }
+  return r;
+}
+
+StabilityReport study_stability(const std::string& model_path,
+                                const StabilityParams& p, double rel_tol) {
+  const auto t0 = std::chrono::steady_clock::now();
+  StabilityReport r;
+  r.params = p;
+  SliderWall wall(model_path, p);  // validates
+  r.k_bound_gil_N_per_m = k_bound_gil_N_per_m(p);
+  r.k_passivity_N_per_m = k_passivity_N_per_m(p);
+  r.exact = k_crit_discrete(p, PlantModel::kExactZoh);
+  r.euler = k_crit_discrete(p, PlantModel::kMujocoEuler);
+  // the exact discrete value only says where to start looking
+  const double guess = r.exact.k_crit_N_per_m > 0.0 ? r.exact.k_crit_N_per_m
+                                                    : r.k_bound_gil_N_per_m;
+  r.sim = k_crit_simulated(wall, guess, rel_tol);
+  r.wall_time_s = std::chrono::duration<double>(
+                      std::chrono::steady_clock::now() - t0)
+                      .count();
+  return r;
+}
+
+// ---------------------------------------------------------------- map
+
+std::vector<MapPoint> stability_map(const std::string& model_path,
+                                    const MapSpec& spec) {
+  std::vector<MapPoint> points;
+  std::vector<StabilityParams> params;
+  for (int n : spec.delay_ticks) {
+    for (double B : spec.virtual_damping_Ns_per_m) {
+      StabilityParams p = spec.base;
+      p.virtual_damping_Ns_per_m = B;
+      p.delay_ticks = n;
+      validate(p);  // every point before any runs
+      params.push_back(p);
+      MapPoint pt;
+      pt.virtual_damping_Ns_per_m = B;
+      pt.delay_ticks = n;
+      points.push_back(pt);
+    }
+  }
+  std::vector<std::exception_ptr> errors(points.size());
+  parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
+    try {
+      const StabilityParams& p = params[i];
+      MapPoint& pt = points[i];
+      pt.k_bound_gil_N_per_m = k_bound_gil_N_per_m(p);
+      pt.k_passivity_N_per_m = k_passivity_N_per_m(p);
+      pt.k_crit_exact_N_per_m =
+          k_crit_discrete(p, PlantModel::kExactZoh).k_crit_N_per_m;
+      pt.k_crit_mujoco_euler_N_per_m =
+          k_crit_discrete(p, PlantModel::kMujocoEuler).k_crit_N_per_m;
+      SliderWall wall(model_path, p);
+      const double guess = pt.k_crit_exact_N_per_m > 0.0
+                               ? pt.k_crit_exact_N_per_m
+                               : pt.k_bound_gil_N_per_m;
+      pt.sim = k_crit_simulated(wall, guess, spec.rel_tol);
+    } catch (...) {
+      errors[i] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+  return points;
+}
+
+std::string stability_map_csv(const std::vector<MapPoint>& points) {
+  std::string out =
+      "virtual_damping_Ns_per_m,delay_ticks,k_crit_sim_N_per_m,"
+      "k_stable_sim_N_per_m,k_unstable_sim_N_per_m,k_crit_exact_N_per_m,"
+      "k_crit_mujoco_euler_N_per_m,k_bound_gil_N_per_m,k_passivity_N_per_m,"
+      "rel_error_sim_vs_exact,rel_error_sim_vs_gil,sim_runs\n";
+  char buf[512];
+  for (const MapPoint& p : points) {
+    std::snprintf(
+        buf, sizeof buf, "%.10g,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.6g,%.6g,%d\n",
+        p.virtual_damping_Ns_per_m, p.delay_ticks, p.sim.k_crit_N_per_m,
+        p.sim.k_stable_N_per_m, p.sim.k_unstable_N_per_m,
+        p.k_crit_exact_N_per_m, p.k_crit_mujoco_euler_N_per_m,
+        p.k_bound_gil_N_per_m, p.k_passivity_N_per_m,
+        p.sim.k_crit_N_per_m / p.k_crit_exact_N_per_m - 1.0,
+        p.sim.k_crit_N_per_m / p.k_bound_gil_N_per_m - 1.0, p.sim.runs);
+    out += buf;
+  }
+  return out;
+}
+
+std::string stability_map_svg(const std::vector<MapPoint>& points,
+                              const StabilityParams& base) {
+  // one colour per delay; the three series of a delay share it
+  static const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c",
+                                        "#9467bd", "#ff7f0e", "#8c564b"};
+  std::vector<int> delays;
+  for (const MapPoint& p : points) {
+    if (std::find(delays.begin(), delays.end(), p.delay_ticks) ==
+        delays.end()) {
+      delays.push_back(p.delay_ticks);
+    }
+  }
+  Chart c;
+  char title[256];
+  std::snprintf(title, sizeof title,
+                "K_crit of the sampled wall: m = %g kg, b = %g N s/m, "
+                "T = %g ms, h = %g us",
+                base.mass_kg, base.damping_Ns_per_m,
+                1e3 * base.servo_period_s, 1e6 * base.physics_step_s);
+  c.title = title;
+  c.x.label = "virtual damping B (N s/m)";
+  c.y.label = "critical stiffness K_crit (N/m)";
+  c.y.min = 0.0;  // the passivity bound goes negative for B > b
+  c.width_px = 860;
+  c.height_px = 500;
+  for (std::size_t i = 0; i < delays.size(); ++i) {
+    const int n = delays[i];
+    const std::string color = kColors[i % (sizeof kColors / sizeof *kColors)];
+    const std::string tag = "n = " + std::to_string(n);
+    ChartSeries sim, exact, gil;
+    sim.label = "simulated, " + tag;
+    sim.line = false;
+    exact.label = "exact discrete, " + tag;
+    exact.markers = false;
+    gil.label = "Gil et al. (b+B)/(T/2+nT), " + tag;
+    gil.markers = false;
+    gil.dashed = true;
+    sim.color = exact.color = gil.color = color;
+    for (const MapPoint& p : points) {
+      if (p.delay_ticks != n) continue;
+      const double B = p.virtual_damping_Ns_per_m;
+      sim.x.push_back(B);
+      sim.y.push_back(p.sim.k_crit_N_per_m);
+      exact.x.push_back(B);
+      exact.y.push_back(p.k_crit_exact_N_per_m);
+      gil.x.push_back(B);
+      gil.y.push_back(p.k_bound_gil_N_per_m);
+    }
+    c.series.push_back(sim);
+    c.series.push_back(exact);
+    c.series.push_back(gil);
+  }
+  ChartSeries passive;
+  passive.label = "passivity 2(b-B)/T (Colgate & Schenkel)";
+  passive.markers = false;
+  passive.dashed = true;
+  passive.color = "#888888";
+  // where it is >= 0: up to B = b, where it reaches 0
+  double B_max = 0.0;
+  for (const MapPoint& p : points) {
+    B_max = std::max(B_max, p.virtual_damping_Ns_per_m);
+    if (p.delay_ticks != delays.front() || p.k_passivity_N_per_m < 0.0) {
+      continue;
+    }
+    passive.x.push_back(p.virtual_damping_Ns_per_m);
+    passive.y.push_back(p.k_passivity_N_per_m);
+  }
+  const double b = base.damping_Ns_per_m;
+  if (b <= B_max && (passive.x.empty() || passive.x.back() < b)) {
+    passive.x.push_back(b);
+    passive.y.push_back(0.0);
+  }
+  if (!passive.x.empty()) c.series.push_back(passive);
+  return chart_svg(c);
+}
+
+}  // namespace vmh::sim

@@ -1,0 +1,276 @@
+// The stability study (`vmhaptics study stability`): the critical stiffness
+// of a sampled-data virtual wall, found by simulation in MuJoCo and checked
+// against theory (REFERENCE.md §6).
+//
+// The scene is models/slider/slider.xml: a 1-DOF slider of mass m with
+// viscous damping b (joint damping), pushed by a motor. A controller sampled
+// every servo period T renders a virtual wall at x = 0, a spring K and a
+// damper B:
+//   - it reads the position x_k at t = kT (no quantisation, no noise),
+//   - estimates the velocity by the backward difference (x_k - x_{k-1}) / T,
+//   - computes F_k = -K x_k - B (x_k - x_{k-1}) / T,
+//   - applies it n ticks later (a computation/communication delay of
+//     t_d = n T) and holds it (zero-order hold) over one period,
+// while MuJoCo steps the slider at h << T.
+//
+// The wall is bilateral: the spring and damper act on both sides of x = 0,
+// as if the slider were coupled to the wall, so that the loop is linear and
+// its stability a property of (m, b, T, B, K, n) alone, which is what the
+// theories below are about. (A one-sided wall makes the loop piecewise
+// linear; it is not studied here.)
+//
+// Theory the simulation is compared with:
+//   - Gil, Avello, Rubio and Flórez 2004, "Stability analysis of a 1 DOF
+//     haptic interface using the Routh-Hurwitz criterion" (IEEE Trans.
+//     Control Systems Technology 12(4)): K < (b + B)/(T/2 + t_d), their
+//     approximation of the Routh-Hurwitz condition for a short period. The
+//     exact discrete loop (below) puts its error, with no delay, at about
+//     +bT/(6m) from b and -BT/m from B (the backward difference's lag on
+//     the damper); a delay makes the b term a little larger. So it holds to
+//     5% while bT/m and BT/m are small (BT/m < ~0.05); the test says where.
+//     The T/2 is the hold's: with the true velocity sampled instead of the
+//     backward difference, the exact K_crit is 2(b + B)/T too, to first
+//     order (VelocityEstimate::kSampled).
+//   - Colgate and Schenkel 1997, "Passivity of a class of sampled-data
+//     systems: application to haptic interfaces" (J. Robotic Systems 14(1)):
+//     the wall is passive iff b > K T/2 + |B|, i.e. K < 2(b - |B|)/T, which
+//     guarantees stability coupled to any passive human and is more
+//     conservative than stability of the device alone (Diolaiti et al.
+//     2006). Abbott and Okamura 2005 ("Effects of position quantization and
+//     sampling rate on virtual-wall passivity", IEEE Trans. Robotics 21(5))
+//     add K < 2 f_c/Δ for Coulomb friction f_c and position quantum Δ,
+//     neither of which the slider has.
+//   - The exact discrete-time loop: the plant m x'' + b x' = F discretised
+//     exactly under the zero-order hold, with the backward-difference and
+//     delay states; K_crit is where its spectral radius reaches 1.
+//
+// The simulation converges to the exact loop as h/T -> 0, from above:
+// MuJoCo's semi-implicit Euler moves x with the step's new velocity, so the
+// held force acts h/2 early and K_crit is higher by about h/((1 + 2n) T)
+// (0.1% at the command line's default h = T/1000). The same loop with
+// MuJoCo's step as the plant (PlantModel::kMujocoEuler) is what the
+// simulation computes, exactly: the two K_crit agree to ~1e-6.
+#ifndef VMHAPTICS_STUDIES_STABILITY_STUDY_H_
+#define VMHAPTICS_STUDIES_STABILITY_STUDY_H_
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "sim/mujoco_util.h"
+
+namespace vmh::sim {
+
+// How the controller estimates the velocity for the damper B.
+enum class VelocityEstimate {
+  kBackwardDifference,  // (x_k - x_{k-1}) / T, as Gil et al. model it
+  kSampled,             // the true velocity at t = kT (a tachometer)
+};
+
+// One setting of the loop, SI units. K is not here: it is what is searched.
+struct StabilityParams {
+  double mass_kg = 0.0;                   // m   (--mass)
+  double damping_Ns_per_m = 0.0;          // b   (--damping), >= 0
+  double servo_period_s = 0.0;            // T   (--servo-period)
+  double virtual_damping_Ns_per_m = 0.0;  // B   (--virtual-damping), >= 0
+  int delay_ticks = 0;                    // n   (--delay-ticks), t_d = n T
+  double physics_step_s = 0.0;            // h   (--physics-step); T = N h
+  VelocityEstimate velocity = VelocityEstimate::kBackwardDifference;
+};
+
+// Throws SimError naming the command-line option when a value is out of
+// range: m > 0, b >= 0, T > 0, B >= 0, b + B > 0 (else no K is stable),
+// 0 <= n <= kStudyMaxDelayTicks, 0 < h <= T with T a whole multiple of h (to
+// 1e-9 relative), and at most kMaxStepsPerTick steps per tick.
+void validate(const StabilityParams& p);
+inline constexpr int kStudyMaxDelayTicks = 20;
+inline constexpr int kMaxStepsPerTick = 100000;
+
+// T / h, the MuJoCo steps per servo tick (p validated).
+int steps_per_tick(const StabilityParams& p);
+
+// ---------------------------------------------------------------- theory
+
+// Gil et al. 2004: (b + B) / (T/2 + n T).
+double k_bound_gil_N_per_m(const StabilityParams& p);
+
+// Colgate and Schenkel 1997: 2 (b - B) / T (B >= 0); <= 0 when B >= b, i.e.
+// no stiffness is passive.
+double k_passivity_N_per_m(const StabilityParams& p);
+
+// How the plant is discretised over one servo period with the force held.
+enum class PlantModel {
+  kExactZoh,     // m x'' + b x' = F solved exactly over T (closed form)
+  kMujocoEuler,  // N = T/h steps of MuJoCo's Euler with implicit damping:
+                 // v' = (m v + h F) / (m + h b), x' = x + h v'
+};
+
+// The closed loop's one-tick transition matrix for the state
+// [x_k, v_k, x_{k-1}, u_{k-1}, ..., u_{k-n}] (u_j: the force computed at
+// tick j), for stiffness K.
+Eigen::MatrixXd closed_loop_matrix(const StabilityParams& p, double k_N_per_m,
+                                   PlantModel plant = PlantModel::kExactZoh);
+
+// Largest |eigenvalue| of closed_loop_matrix (Eigen::EigenSolver).
+double spectral_radius(const StabilityParams& p, double k_N_per_m,
+                       PlantModel plant = PlantModel::kExactZoh);
+
+struct DiscreteKcrit {
+  double k_crit_N_per_m = 0.0;  // 0 if no K > 0 is stable
+  int iterations = 0;           // eigenvalue evaluations
+};
+
+// The K at which the spectral radius reaches 1, by bisection to a relative
+// `rel_tol`: the smallest K above which the loop is unstable, searched from
+// K -> 0+ (where the free slider's integrator pole at z = 1 moves inside
+// the unit circle) upward. Assumes one crossing, as for this loop.
+DiscreteKcrit k_crit_discrete(const StabilityParams& p,
+                              PlantModel plant = PlantModel::kExactZoh,
+                              double rel_tol = 1e-9);
+
+// ---------------------------------------------------------------- simulation
+
+// What one simulated run says about the envelope of the oscillation.
+struct WallRun {
+  double k_N_per_m = 0.0;
+  bool stable = false;   // the envelope decays
+  bool diverged = false;  // |x| passed kDivergedFactor x0: stopped early
+  int ticks = 0;          // servo ticks simulated
+  // the envelope's growth rate, 1/s (< 0: decays), from the windows below
+  double growth_rate_per_s = 0.0;
+  // largest |x| in the early and the late window, m
+  double early_peak_m = 0.0;
+  double late_peak_m = 0.0;
+};
+
+inline constexpr double kInitialDisplacement_m = 1e-3;
+inline constexpr double kDivergedFactor = 1e4;
+
+// The slider model with m, b and h set from the parameters, and one
+// mjData; runs the wall at any K and n = p.delay_ticks.
+class SliderWall {
+ public:
+  // Loads `model_path` (models/slider/slider.xml) and sets body_mass (and
+  // the inertia, scaled alike), dof_damping and opt.timestep, then
+  // mj_setConst. Throws SimError for bad parameters (validate) or a model
+  // that is not a slider.
+  SliderWall(const std::string& model_path, const StabilityParams& p);
+
+  const StabilityParams& params() const { return p_; }
+  const mjModel* model() const { return m_.get(); }
+
+  // The number of servo ticks run() simulates at stiffness K: enough for
+  // kHorizonPeriods periods of the undamped oscillation sqrt(K/m) and at
+  // least kMinHorizonTicks.
+  //
+  // Why that is enough near the boundary, where the envelope changes by
+  // only ~1e-4 over the run: run() does not compare peaks (sampled once a
+  // tick, a peak is off by up to (pi/ticks per period)²/2, 0.05% at 100
+  // ticks a period, larger than the signal) but the window sums of
+  // Q_k = x_k² - x_{k-1} x_{k+1}, which for the dominant mode grow as
+  // rho^{2k} with no ripple. What limits it is the other modes (the
+  // backward difference's and the delay line's), which must have died out
+  // before the early window: |z| <= 0.7 in the sets tried, so 0.7^100 ~
+  // 3e-16 at the window's start a third into 300 ticks. Three periods keep
+  // each window a whole period long. The test checks the result against
+  // the discrete loop's spectral radius to 1e-4; it agrees to ~1e-6.
+  int horizon_ticks(double k_N_per_m) const;
+
+  // One run from x = kInitialDisplacement_m at rest, the controller's
+  // previous sample equal to it and no force in the delay line. `ticks` 0:
+  // horizon_ticks(K). If `x_per_tick` is given it receives x_k, m.
+  WallRun run(double k_N_per_m, int ticks = 0,
+              std::vector<double>* x_per_tick = nullptr);
+
+ private:
+  StabilityParams p_;
+  ModelPtr m_;
+  DataPtr d_;
+  int steps_per_tick_ = 1;
+};
+
+inline constexpr double kHorizonPeriods = 3.0;
+inline constexpr int kMinHorizonTicks = 300;
+
+struct SimKcrit {
+  // the zero of the measured growth rate, interpolated linearly between
+  // the bracket's two runs (or its middle, if not interpolated)
+  double k_crit_N_per_m = 0.0;
+  bool interpolated = false;
+  double k_stable_N_per_m = 0.0;    // largest K seen to decay
+  double k_unstable_N_per_m = 0.0;  // smallest K seen to grow
+  int runs = 0;                     // simulated runs, bracketing included
+  long long physics_steps = 0;
+  std::vector<WallRun> history;     // every run, in order
+};
+
+// K_crit by simulation: a bracket [K_stable, K_unstable] found around
+// `k_guess_N_per_m` (K_guess x 1.03^-1 and x 1.03, widened geometrically
+// until one run decays and the other grows), then bisected until
+// (K_unstable - K_stable) / K_stable <= rel_tol. The guess only says where
+// to look; every K is judged by a run.
+SimKcrit k_crit_simulated(SliderWall& wall, double k_guess_N_per_m,
+                          double rel_tol = 2e-3);
+
+// The whole comparison for one setting.
+struct StabilityReport {
+  StabilityParams params;
+  SimKcrit sim;
+  DiscreteKcrit exact;        // exact ZOH plant
+  DiscreteKcrit euler;        // MuJoCo's Euler plant at the same h
+  double k_bound_gil_N_per_m = 0.0;
+  double k_passivity_N_per_m = 0.0;
+  double wall_time_s = 0.0;
+};
+
+StabilityReport study_stability(const std::string& model_path,
+                                const StabilityParams& p,
+                                double rel_tol = 2e-3);
+
+// ---------------------------------------------------------------- map
+
+// K_crit against the virtual damping B, for each delay n: the boundary of
+// the stable region in the (B, K) plane.
+struct MapSpec {
+  StabilityParams base;  // m, b, T, h; B and n are swept
+  std::vector<double> virtual_damping_Ns_per_m;
+  std::vector<int> delay_ticks;
+  double rel_tol = 2e-3;
+  int jobs = 1;  // threads, each with its own model and data
+};
+
+struct MapPoint {
+  double virtual_damping_Ns_per_m = 0.0;
+  int delay_ticks = 0;
+  SimKcrit sim;
+  double k_crit_exact_N_per_m = 0.0;
+  double k_crit_mujoco_euler_N_per_m = 0.0;
+  double k_bound_gil_N_per_m = 0.0;
+  double k_passivity_N_per_m = 0.0;
+};
+
+// One point per (B, n), ordered by n then B. Throws SimError (validate) for
+// a bad point before simulating any.
+std::vector<MapPoint> stability_map(const std::string& model_path,
+                                    const MapSpec& spec);
+
+// The map as CSV, units in the column names: virtual_damping_Ns_per_m,
+// delay_ticks, k_crit_sim_N_per_m, k_stable_sim_N_per_m,
+// k_unstable_sim_N_per_m, k_crit_exact_N_per_m, k_crit_mujoco_euler_N_per_m,
+// k_bound_gil_N_per_m, k_passivity_N_per_m, rel_error_sim_vs_exact,
+// rel_error_sim_vs_gil, sim_runs.
+std::string stability_map_csv(const std::vector<MapPoint>& points);
+
+// The map as an SVG chart (sim/svg_chart.h): K_crit against B, for each
+// delay the simulated points as markers, the exact discrete boundary as a
+// line and Gil et al.'s bound dashed, with Colgate and Schenkel's passivity
+// bound dashed in grey (where it is > 0).
+std::string stability_map_svg(const std::vector<MapPoint>& points,
+                              const StabilityParams& base);
+
+// The slider's model file under `models_dir`.
+std::string slider_model_path(const std::string& models_dir);
+
+}  // namespace vmh::sim
+
+#endif  // VMHAPTICS_STUDIES_STABILITY_STUDY_H_

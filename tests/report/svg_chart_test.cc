@@ -1,0 +1,349 @@
+// sim/svg_chart.cc: the chart is well-formed SVG, and its pixels say what
+// the data says. Points are read back from the series' <polyline> and
+// <circle> elements and mapped against the plot area's frame
+// (<rect class="plot-area">): a point on an axis limit lands on the frame's
+// edge, a linear axis is linear, a log axis spaces decades equally, dropped
+// points are counted in <desc>.
+//
+// With VMH_SVG_CHART_DIR set, the charts are also written there for a look.
+#include "report/svg_chart.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tests/support/svg_check.h"
+
+namespace vmh::sim {
+namespace {
+
+using vmh::testing::count;
+using vmh::testing::tag_problems;
+
+using Pt = std::pair<double, double>;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kPx = 0.006;  // the document prints pixels to 0.01
+
+void save(const std::string& name, const std::string& doc) {
+  if (const char* dir = std::getenv("VMH_SVG_CHART_DIR")) {
+    std::ofstream(std::string(dir) + "/" + name + ".svg") << doc;
+  }
+}
+
+// the attributes of the first element <name ... class="cls" ...>
+std::map<std::string, std::string> attributes(const std::string& element) {
+  std::map<std::string, std::string> a;
+  static const std::regex kAttr(R"re(([A-Za-z0-9:-]+)="([^"]*)")re");
+  for (std::sregex_iterator m(element.begin(), element.end(), kAttr), end;
+       m != end; ++m) {
+    a[(*m)[1].str()] = (*m)[2].str();
+  }
+  return a;
+}
+
+struct Frame {
+  double x = kNaN, y = kNaN, w = kNaN, h = kNaN;
+  double left() const { return x; }
+  double right() const { return x + w; }
+  double top() const { return y; }
+  double bottom() const { return y + h; }
+};
+
+Frame plot_area(const std::string& doc) {
+  const std::size_t at = doc.find("class=\"plot-area\"");
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "no plot-area";
+    return {};
+  }
+  const auto a = attributes(doc.substr(doc.rfind('<', at), doc.find('>', at) - doc.rfind('<', at)));
+  return {std::stod(a.at("x")), std::stod(a.at("y")), std::stod(a.at("width")),
+          std::stod(a.at("height"))};
+}
+
+// the text of <g class="series" id="series-N"> ... </g>
+std::string series_group(const std::string& doc, int n) {
+  const std::string head = "<g class=\"series\" id=\"series-" + std::to_string(n) + "\"";
+  const std::size_t at = doc.find(head);
+  if (at == std::string::npos) return "";
+  return doc.substr(at, doc.find("</g>", at) - at);
+}
+
+std::vector<Pt> markers(const std::string& group) {
+  std::vector<Pt> pts;
+  for (std::size_t at = group.find("<circle"); at != std::string::npos;
+       at = group.find("<circle", at + 1)) {
+    const auto a = attributes(group.substr(at, group.find('>', at) - at));
+    pts.emplace_back(std::stod(a.at("cx")), std::stod(a.at("cy")));
+  }
+  return pts;
+}
+
+// the polyline's points; empty if there is none
+std::vector<Pt> polyline(const std::string& group) {
+  std::vector<Pt> pts;
+  const std::size_t at = group.find("<polyline");
+  if (at == std::string::npos) return pts;
+  const auto a = attributes(group.substr(at, group.find('>', at) - at));
+  std::istringstream in(a.at("points"));
+  std::string item;
+  while (in >> item) {
+    const std::size_t comma = item.find(',');
+    pts.emplace_back(std::stod(item.substr(0, comma)),
+                     std::stod(item.substr(comma + 1)));
+  }
+  return pts;
+}
+
+std::string desc(const std::string& doc) {
+  const std::size_t a = doc.find("<desc>") + 6;
+  return doc.substr(a, doc.find("</desc>", a) - a);
+}
+
+ChartSeries series(std::vector<double> x, std::vector<double> y,
+                   std::string label = "s") {
+  ChartSeries s;
+  s.label = std::move(label);
+  s.x = std::move(x);
+  s.y = std::move(y);
+  return s;
+}
+
+// Fixed linear axes: the corners of the range land on the frame's corners,
+// the middle in its middle, y up.
+TEST(SvgChartTest, LinearAxisLimitsLandOnTheFrameEdges) {
+  Chart c;
+  c.title = "linear";
+  c.x = {"x (m)", false, 0.0, 10.0};
+  c.y = {"y (N)", false, -5.0, 5.0};
+  c.series.push_back(series({0.0, 10.0, 5.0, 2.5}, {-5.0, 5.0, 0.0, 2.5}));
+  const std::string doc = chart_svg(c);
+  save("linear", doc);
+  EXPECT_EQ(tag_problems(doc), "");
+  const Frame f = plot_area(doc);
+  ASSERT_GT(f.w, 100.0);
+  ASSERT_GT(f.h, 100.0);
+  const std::vector<Pt> m = markers(series_group(doc, 0));
+  ASSERT_EQ(m.size(), 4u);
+  EXPECT_NEAR(m[0].first, f.left(), kPx);     // x = min: the left edge
+  EXPECT_NEAR(m[0].second, f.bottom(), kPx);  // y = min: the bottom edge
+  EXPECT_NEAR(m[1].first, f.right(), kPx);
+  EXPECT_NEAR(m[1].second, f.top(), kPx);
+  EXPECT_NEAR(m[2].first, f.left() + 0.5 * f.w, kPx);
+  EXPECT_NEAR(m[2].second, f.top() + 0.5 * f.h, kPx);
+  EXPECT_NEAR(m[3].first, f.left() + 0.25 * f.w, kPx);
+  EXPECT_NEAR(m[3].second, f.top() + 0.25 * f.h, kPx);
+  // the polyline goes through the same pixels, in the data's order
+  EXPECT_EQ(polyline(series_group(doc, 0)), m);
+  // labels, ticks
+  EXPECT_EQ(count(doc, "class=\"axis-label\""), 2u);
+  EXPECT_NE(doc.find(">x (m)</text>"), std::string::npos);
+  EXPECT_NE(doc.find(">y (N)</text>"), std::string::npos);
+  EXPECT_NE(doc.find(">linear</text>"), std::string::npos);
+  for (const char* tick : {">0</text>", ">10</text>", ">-4</text>", ">4</text>"}) {
+    EXPECT_NE(doc.find(tick), std::string::npos) << tick;
+  }
+  EXPECT_EQ(doc.rfind("<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" class=\"chart\"", 0), 0u);
+}
+
+// Log axes from the data: whole decades, 10 and 100 one decade apart, as far
+// apart in pixels as 100 and 1000, and a decade's ticks labelled 10^k.
+TEST(SvgChartTest, LogAxisSpacesDecadesEqually) {
+  Chart c;
+  c.x = {"wall time (s)", true};
+  c.y = {"error (m)", true};
+  c.series.push_back(series({10.0, 100.0, 1000.0, 31.622776601683793},
+                            {1e-3, 1e-5, 1e-7, 1e-4}));
+  const std::string doc = chart_svg(c);
+  save("loglog", doc);
+  EXPECT_EQ(tag_problems(doc), "");
+  const Frame f = plot_area(doc);
+  const std::vector<Pt> m = markers(series_group(doc, 0));
+  ASSERT_EQ(m.size(), 4u);
+  // the data span whole decades here, so the axes are exactly 10..1000 and
+  // 1e-7..1e-3
+  EXPECT_NEAR(m[0].first, f.left(), kPx);
+  EXPECT_NEAR(m[2].first, f.right(), kPx);
+  EXPECT_NEAR(m[0].second, f.top(), kPx);
+  EXPECT_NEAR(m[2].second, f.bottom(), kPx);
+  const double decade_x = m[1].first - m[0].first;
+  EXPECT_NEAR(decade_x, 0.5 * f.w, kPx);
+  EXPECT_NEAR(m[2].first - m[1].first, decade_x, 2 * kPx);
+  EXPECT_NEAR(m[1].second - m[0].second, 0.5 * f.h, kPx);  // two decades down
+  // sqrt(1000) is half a decade above 10; 1e-4 three quarters of the way
+  EXPECT_NEAR(m[3].first, f.left() + 0.25 * f.w, kPx);
+  EXPECT_NEAR(m[3].second, f.top() + 0.25 * f.h, kPx);
+  // decade ticks: 10^1, 10^2, 10^3 on x; 10^-7 .. 10^-3 on y
+  for (const char* e : {">1<", ">2<", ">3<", ">-7<", ">-5<", ">-3<"}) {
+    EXPECT_NE(doc.find(std::string("10<tspan dy=\"-5\" font-size=\"8\"") + e),
+              std::string::npos)
+        << e;
+  }
+}
+
+// Data not on whole decades: the log axis widens to the decades around
+// them; an axis from data on a linear axis is padded, so every point is
+// inside the frame and none on its edge.
+TEST(SvgChartTest, RangesFromTheData) {
+  Chart c;
+  c.x = {"x", true};
+  c.y = {"y", false};
+  c.series.push_back(series({2.0, 50.0}, {3.0, 7.0}));
+  const std::string doc = chart_svg(c);
+  const Frame f = plot_area(doc);
+  const std::vector<Pt> m = markers(series_group(doc, 0));
+  ASSERT_EQ(m.size(), 2u);
+  // x axis 1..100: log10(2) and log10(50) of the two decades
+  EXPECT_NEAR(m[0].first, f.left() + std::log10(2.0) / 2.0 * f.w, kPx);
+  EXPECT_NEAR(m[1].first, f.left() + std::log10(50.0) / 2.0 * f.w, kPx);
+  // y axis 3 - 0.2 .. 7 + 0.2 (5% of the span each side)
+  EXPECT_NEAR(m[0].second, f.bottom() - 0.2 / 4.4 * f.h, kPx);
+  EXPECT_NEAR(m[1].second, f.top() + 0.2 / 4.4 * f.h, kPx);
+
+  // one value only, and no data at all: still a frame with finite numbers
+  Chart one;
+  one.series.push_back(series({5.0}, {0.0}));
+  const std::string d1 = chart_svg(one);
+  EXPECT_EQ(tag_problems(d1), "");
+  const Frame f1 = plot_area(d1);
+  const std::vector<Pt> m1 = markers(series_group(d1, 0));
+  ASSERT_EQ(m1.size(), 1u);
+  EXPECT_NEAR(m1[0].first, f1.left() + 0.5 * f1.w, kPx);
+  EXPECT_NEAR(m1[0].second, f1.top() + 0.5 * f1.h, kPx);
+  EXPECT_TRUE(polyline(series_group(d1, 0)).empty());  // one point: no line
+  Chart none;
+  none.x.log = true;
+  const std::string d0 = chart_svg(none);
+  EXPECT_EQ(tag_problems(d0), "");
+  EXPECT_EQ(d0.find("nan"), std::string::npos);
+  EXPECT_EQ(d0.find("inf"), std::string::npos);
+}
+
+// Non-finite points are dropped everywhere, non-positive ones on a log
+// axis; the markers are the points left, and <desc> counts the rest.
+TEST(SvgChartTest, DropsPointsItCannotDrawAndSaysHowMany) {
+  Chart c;
+  c.x = {"x", false, 0.0, 4.0};
+  c.y = {"y", true, 1.0, 1000.0};
+  c.series.push_back(series({0.0, 1.0, 2.0, 3.0, 4.0, kNaN},
+                            {10.0, kNaN, -1.0, 0.0, 100.0, 5.0}, "a"));
+  c.series.push_back(series({0.5, kInf, 1.5}, {2.0, 3.0, 4.0}, "b"));
+  const std::string doc = chart_svg(c);
+  EXPECT_EQ(tag_problems(doc), "");
+  EXPECT_NE(desc(doc).find("4 points drawn"), std::string::npos) << desc(doc);
+  EXPECT_NE(desc(doc).find("3 non-finite point(s)"), std::string::npos) << desc(doc);
+  EXPECT_NE(desc(doc).find("2 non-positive point(s)"), std::string::npos) << desc(doc);
+  const Frame f = plot_area(doc);
+  const std::vector<Pt> a = markers(series_group(doc, 0));
+  ASSERT_EQ(a.size(), 2u);  // (0, 10) and (4, 100)
+  EXPECT_NEAR(a[0].first, f.left(), kPx);
+  EXPECT_NEAR(a[0].second, f.bottom() - f.h / 3.0, kPx);
+  EXPECT_NEAR(a[1].first, f.right(), kPx);
+  EXPECT_NEAR(a[1].second, f.bottom() - 2.0 * f.h / 3.0, kPx);
+  EXPECT_EQ(polyline(series_group(doc, 0)), a);
+  EXPECT_EQ(markers(series_group(doc, 1)).size(), 2u);
+  EXPECT_EQ(doc.find("nan"), std::string::npos);
+  EXPECT_EQ(doc.find("inf"), std::string::npos);
+  // every circle in the document is a marker of a series
+  EXPECT_EQ(count(doc, "<circle"), 4u);
+}
+
+// Each series in its own group, in order: polyline and/or markers as asked,
+// dashed when asked, a palette colour unless one is given; the legend names
+// them.
+TEST(SvgChartTest, SeriesStylesColoursAndLegend) {
+  Chart c;
+  c.x = {"B (N s/m)"};
+  c.y = {"K_crit (N/m)"};
+  ChartSeries sim = series({0, 1, 2}, {1, 2, 3}, "simulated");
+  sim.line = false;
+  ChartSeries theory = series({0, 1, 2}, {1.1, 2.1, 3.1}, "2(b+B)/T");
+  theory.markers = false;
+  theory.dashed = true;
+  ChartSeries given = series({0, 2}, {0, 1}, "given <colour> & more");
+  given.color = "rgb(1,2,3)";
+  ChartSeries unnamed = series({0, 2}, {1, 0}, "");
+  c.series = {sim, theory, given, unnamed};
+  const std::string doc = chart_svg(c);
+  save("styles", doc);
+  EXPECT_EQ(tag_problems(doc), "");
+  EXPECT_EQ(count(doc, "class=\"series\""), 4u);
+  const std::string g0 = series_group(doc, 0), g1 = series_group(doc, 1);
+  const std::string g2 = series_group(doc, 2), g3 = series_group(doc, 3);
+  EXPECT_TRUE(polyline(g0).empty());
+  EXPECT_EQ(markers(g0).size(), 3u);
+  EXPECT_EQ(polyline(g1).size(), 3u);
+  EXPECT_TRUE(markers(g1).empty());
+  EXPECT_NE(g1.find("stroke-dasharray"), std::string::npos);
+  EXPECT_EQ(g0.find("stroke-dasharray"), std::string::npos);
+  EXPECT_EQ(g2.find("stroke-dasharray"), std::string::npos);
+  // palette: the first, second and third palette colours go to the series
+  // without one; the given colour is used as given
+  EXPECT_NE(g0.find("fill=\"#1f77b4\""), std::string::npos);
+  EXPECT_NE(g1.find("stroke=\"#ff7f0e\""), std::string::npos);
+  EXPECT_NE(g2.find("rgb(1,2,3)"), std::string::npos);
+  EXPECT_NE(g3.find("#2ca02c"), std::string::npos);
+  // legend: the labelled series only, text escaped
+  const std::size_t legend = doc.find("<g class=\"legend\">");
+  ASSERT_NE(legend, std::string::npos);
+  const std::string lg = doc.substr(legend, doc.find("</g>", legend) - legend);
+  EXPECT_EQ(count(lg, "<text"), 3u);
+  EXPECT_NE(lg.find(">simulated</text>"), std::string::npos);
+  EXPECT_NE(lg.find(">2(b+B)/T</text>"), std::string::npos);
+  EXPECT_NE(lg.find(">given &lt;colour&gt; &amp; more</text>"), std::string::npos);
+  EXPECT_NE(lg.find("stroke-dasharray"), std::string::npos);
+  // the legend is outside the plot area, to its right
+  const Frame f = plot_area(doc);
+  const auto first_text = attributes(lg.substr(lg.find("<text"), lg.find('>', lg.find("<text")) - lg.find("<text")));
+  EXPECT_GT(std::stod(first_text.at("x")), f.right());
+  EXPECT_LT(std::stod(first_text.at("x")), c.width_px);
+}
+
+// More series than colours: the palette wraps around.
+TEST(SvgChartTest, PaletteWraps) {
+  Chart c;
+  for (int i = 0; i < 11; ++i) c.series.push_back(series({0, 1}, {0, 1.0 * i}));
+  const std::string doc = chart_svg(c);
+  EXPECT_NE(series_group(doc, 10).find("#1f77b4"), std::string::npos);
+  EXPECT_NE(series_group(doc, 9).find("#17becf"), std::string::npos);
+}
+
+TEST(SvgChartTest, MismatchedLengthsThrow) {
+  Chart c;
+  c.series.push_back(series({0, 1}, {0, 1}));
+  c.series.push_back(series({0, 1, 2}, {0, 1}, "bad"));
+  try {
+    chart_svg(c);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("series 1"), std::string::npos) << e.what();
+  }
+}
+
+// A limit a log axis cannot use is ignored (the data's decades are used)
+// and said so.
+TEST(SvgChartTest, UnusableLimitsAreIgnoredAndNoted) {
+  Chart c;
+  c.x = {"x", true, -1.0, 100.0};
+  c.series.push_back(series({1.0, 10.0}, {0.0, 1.0}));
+  const std::string doc = chart_svg(c);
+  EXPECT_NE(desc(doc).find("x axis minimum -1 was ignored"), std::string::npos) << desc(doc);
+  const Frame f = plot_area(doc);
+  const std::vector<Pt> m = markers(series_group(doc, 0));
+  ASSERT_EQ(m.size(), 2u);
+  EXPECT_NEAR(m[0].first, f.left(), kPx);  // 1 .. 100
+  EXPECT_NEAR(m[1].first, f.left() + 0.5 * f.w, kPx);
+}
+
+}  // namespace
+}  // namespace vmh::sim
