@@ -52,25 +52,18 @@ ClosedLoop& warm_loop(ClosedLoop* loop) {
   return *loop;
 }
 
-// `with_hand`: the hand's wrench at every step through mjcb_control
+// `with_hand`: the loop's own data, whose hand (registered for it, sim/hand.h)
+// adds its wrench at every step; without: a copy of that data, which has no
+// hand registered, so mj_step is bare MuJoCo
 void step_model(benchmark::State& state, bool with_hand) {
   ClosedLoop loop(case_scene(static_cast<int>(state.range(0))),
                   setting(state.range(1)));
   warm_loop(&loop);
   const mjModel* m = loop.model();
-  DataPtr d(mj_makeData(m));
-  mj_copyData(d.get(), m, loop.data());
-  // the loop's own callback dispatches only to its own mjData; this one
-  // applies the loop's hand to the copy
-  static thread_local SimHand* hand = nullptr;
-  hand = with_hand ? &loop.hand() : nullptr;
-  mjcb_control = [](const mjModel* mm, mjData* dd) {
-    if (hand != nullptr) hand->apply(mm, dd);
-  };
-  if (!with_hand) mjcb_control = nullptr;
-  for (auto _ : state) mj_step(m, d.get());
-  mjcb_control = nullptr;
-  hand = nullptr;
+  DataPtr copy(mj_makeData(m));
+  mj_copyData(copy.get(), m, loop.data());
+  mjData* d = with_hand ? loop.data() : copy.get();
+  for (auto _ : state) mj_step(m, d);
   state.SetItemsProcessed(state.iterations());
   state.counters["time_s"] = d->time;
 }

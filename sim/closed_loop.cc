@@ -13,28 +13,6 @@ using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
 constexpr double kPi = 3.14159265358979323846;
 
-// the loop whose hand the control callback drives, per thread
-thread_local ClosedLoop* t_active = nullptr;
-
-void control_callback(const mjModel* m, mjData* d) {
-  if (t_active != nullptr) t_active->on_control(m, d);
-}
-
-// makes `loop` the active one for the scope, restoring the previous
-class ActiveLoop {
- public:
-  explicit ActiveLoop(ClosedLoop* loop) : previous_(t_active) {
-    t_active = loop;
-    mjcb_control = control_callback;
-  }
-  ~ActiveLoop() { t_active = previous_; }
-  ActiveLoop(const ActiveLoop&) = delete;
-  ActiveLoop& operator=(const ActiveLoop&) = delete;
-
- private:
-  ClosedLoop* previous_;
-};
-
 // splitmix64 (Steele, Lea & Flood, OOPSLA 2014): a fixed, portable sequence,
 // so that a jitter_seed means the same run with any standard library
 std::uint64_t next_random(std::uint64_t* state) {
@@ -180,9 +158,7 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
   reset();
 }
 
-ClosedLoop::~ClosedLoop() {
-  if (t_active == this) t_active = nullptr;
-}
+ClosedLoop::~ClosedLoop() = default;
 
 void ClosedLoop::set_reference(const ControllerParams& params) {
   reference_ = std::make_unique<Controller>(params);
@@ -224,7 +200,6 @@ void ClosedLoop::reset() {
     d->qpos[m->jnt_qposadr[j]] = q_start_dh_[i];
   }
   set_hand_target(0.0);
-  ActiveLoop active(this);
   mj_forward(m, d);
 }
 
@@ -258,10 +233,6 @@ void ClosedLoop::set_hand_target(double t_s) {
   const Eigen::AngleAxisd dR(R2 * target.R.transpose());
   target.w_rad_s = dR.angle() * dR.axis() / dt;
   hand_->set_target(m, data_.get(), target);
-}
-
-void ClosedLoop::on_control(const mjModel* m, mjData* d) {
-  if (d == data_.get()) hand_->apply(m, d);
 }
 
 double ClosedLoop::distance_to_path_mm(const Vec3& p_mm) const {
@@ -300,7 +271,6 @@ Vec3 ClosedLoop::nearest_on_path_mm(const Vec3& p_mm) const {
 }
 
 void ClosedLoop::tick(TraceRow* row) {
-  ActiveLoop active(this);
   const double t = time_s();
   row->t_s = t;
   set_hand_target(t);

@@ -8,7 +8,8 @@
 //      puts them in d->ctrl;
 //   3. MuJoCo steps n = T / h times with d->ctrl held (zero-order hold); the
 //      hand's wrench is recomputed at every step (and at every RK4 stage)
-//      from mjcb_control.
+//      by the hand's own mjcb_control (sim/hand.h), installed once: plain
+//      mj_step on data() gives the same physics.
 // servo_tick talks to the device through two decorators (sim/fault_injector.h):
 // ReadingGuard (the device layer's plausibility check, `sensor_guard`) over
 // FaultInjector (the case's `fault`, none by default) over SimDevice.
@@ -25,8 +26,8 @@
 // over a step (ZOH, fixed tendons), so this is the exact work along the
 // integrated motion for any integrator. The hand's work is summed the same
 // way from qfrc_applied (exact for Euler; for RK4 the last stage's wrench).
-// The hand's callback is found through a thread-local pointer, so loops in
-// different threads do not disturb each other.
+// Each loop's hand is registered for its own mjData, so loops in different
+// threads do not disturb each other.
 #ifndef VMHAPTICS_SIM_CLOSED_LOOP_H_
 #define VMHAPTICS_SIM_CLOSED_LOOP_H_
 
@@ -136,6 +137,10 @@ class ClosedLoop {
   FaultInjector& injector() { return *injector_; }
   ReadingGuard& guard() { return *guard_; }
   SimHand& hand() { return *hand_; }
+  // Sets the hand's target (and its velocity) for simulated time t_s from
+  // the script, as tick() does before it steps: what a caller that steps
+  // data() itself (a viewer, a test) does to play the script.
+  void set_hand_target(double t_s);
 
   // distance (mm) from a device-frame point to the VM's path: the circle,
   // the sphere or the plane, in closed form
@@ -144,11 +149,7 @@ class ClosedLoop {
   // (for the surface: the point L above the plane over it)
   Vec3 nearest_on_path_mm(const Vec3& p_mm) const;
 
-  // called from mjcb_control for this loop's data
-  void on_control(const mjModel* m, mjData* d);
-
  private:
-  void set_hand_target(double t_s);
   // the next tick's physics steps (drawn when jittered)
   int draw_substeps();
 

@@ -1,7 +1,10 @@
 #include "sim/hand.h"
 
 #include <Eigen/Eigenvalues>
+#include <array>
+#include <atomic>
 #include <cstring>
+#include <mutex>
 
 #include "sim/mujoco_util.h"
 
@@ -21,7 +24,65 @@ Mat3 point_inertia(double m, const Vec3& r) {
   return m * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
 }
 
+// The registry of hands: which SimHand belongs to which mjData. Slots are
+// claimed and released under a mutex (construction and destruction); the
+// callback reads them without a lock, at every evaluation of the dynamics.
+// A slot's hand is written before its data and cleared after it, so a
+// reader that finds the data finds its hand.
+struct Slot {
+  std::atomic<const mjData*> data{nullptr};
+  std::atomic<SimHand*> hand{nullptr};
+};
+std::array<Slot, SimHand::kMaxHands> g_slots;
+std::mutex g_registry_mutex;
+
+void register_hand(const mjData* d, SimHand* hand, const std::string& source) {
+  std::lock_guard<std::mutex> lock(g_registry_mutex);
+  if (mjcb_control != nullptr && mjcb_control != hand_control_callback) {
+    throw SimError(source +
+                   ": mjcb_control is set by other code; the simulated hand "
+                   "owns it (sim/hand.h)");
+  }
+  Slot* free_slot = nullptr;
+  for (Slot& s : g_slots) {
+    const mjData* owner = s.data.load(std::memory_order_acquire);
+    if (owner == d) throw SimError(source + ": this mjData already has a hand");
+    if (owner == nullptr && free_slot == nullptr) free_slot = &s;
+  }
+  if (free_slot == nullptr) {
+    throw SimError(source + ": more than " + std::to_string(SimHand::kMaxHands) +
+                   " simulated hands at once");
+  }
+  free_slot->hand.store(hand, std::memory_order_release);
+  free_slot->data.store(d, std::memory_order_release);
+  mjcb_control = hand_control_callback;
+}
+
+void unregister_hand(const mjData* d) {
+  std::lock_guard<std::mutex> lock(g_registry_mutex);
+  for (Slot& s : g_slots) {
+    if (s.data.load(std::memory_order_acquire) == d) {
+      s.data.store(nullptr, std::memory_order_release);
+      s.hand.store(nullptr, std::memory_order_release);
+    }
+  }
+}
+
 }  // namespace
+
+SimHand* registered_hand(const mjData* d) {
+  for (Slot& s : g_slots) {
+    if (s.data.load(std::memory_order_acquire) == d) {
+      return s.hand.load(std::memory_order_acquire);
+    }
+  }
+  return nullptr;
+}
+
+void hand_control_callback(const mjModel* m, mjData* d) {
+  SimHand* hand = registered_hand(d);
+  if (hand != nullptr) hand->apply(m, d);
+}
 
 HandParams hand_params(const CaseConfig& c) {
   HandParams h;
@@ -74,6 +135,13 @@ SimHand::SimHand(mjModel* m, mjData* d, const HandParams& params,
   }
   mju_mat2Quat(m->body_iquat + 4 * b, axes_row.data());
   mj_setConst(m, d);
+
+  register_hand(d, this, source);
+  data_ = d;
+}
+
+SimHand::~SimHand() {
+  if (data_ != nullptr) unregister_hand(data_);
 }
 
 void SimHand::set_target(const mjModel* m, mjData* d,

@@ -10,6 +10,17 @@
 //   tau = K_r r(R_target R_grip^T) + B_r (w_target - w_grip)
 // with r(.) the rotation vector, all in the world (DH base) frame, SI units.
 // Parameters: models/hand/README.md (REFERENCE.md §5).
+//
+// Who computes the wrench: MuJoCo's global mjcb_control, whose one owner is
+// this file. The first SimHand installs hand_control_callback() there; each
+// SimHand registers the mjData it was built for, and the callback applies
+// the hand registered for the data being stepped (and does nothing for data
+// without one). So the physics of a scene is the same whoever calls mj_step
+// or mj_forward on its data (the closed loop, a viewer, a test), in any
+// thread, and nobody sets mjcb_control per tick. A SimHand refuses to be
+// built if some other code already owns mjcb_control. While a hand is
+// registered, d->qfrc_applied is the hand's: it is overwritten at every
+// evaluation.
 #ifndef VMHAPTICS_SIM_HAND_H_
 #define VMHAPTICS_SIM_HAND_H_
 
@@ -44,18 +55,31 @@ struct HandTargetState {
 class SimHand {
  public:
   // Finds the "grip" site and the "hand_target" mocap body, adds the hand's
-  // mass to the grip's body, and recomputes the model's constants
-  // (mj_setConst). Throws SimError naming what is missing.
+  // mass to the grip's body, recomputes the model's constants
+  // (mj_setConst), and registers itself as the hand of `d` (see above).
+  // Throws SimError naming what is missing, if `d` already has a hand, if
+  // too many hands are registered at once (kMaxHands), or if mjcb_control
+  // belongs to someone else. `m` and `d` must outlive the hand.
   SimHand(mjModel* m, mjData* d, const HandParams& params,
           const std::string& source);
+  // unregisters: stepping `d` afterwards applies no hand
+  ~SimHand();
+  SimHand(const SimHand&) = delete;
+  SimHand& operator=(const SimHand&) = delete;
+
+  // the most hands registered at once (one per concurrently simulated scene)
+  static constexpr int kMaxHands = 64;
 
   // Sets the target (and moves the mocap body, for viewing).
   void set_target(const mjModel* m, mjData* d, const HandTargetState& target);
 
   // Clears d->qfrc_applied and adds the hand's wrench. Positions and
-  // velocities in d must be current (call from mjcb_control, or after
+  // velocities in d must be current (mjcb_control calls it; or after
   // mj_forward). Allocates nothing.
   void apply(const mjModel* m, mjData* d);
+
+  // the data this hand is registered for
+  const mjData* data() const { return data_; }
 
   // the last wrench applied at the grip, world frame
   const Vec3& force_N() const { return force_N_; }
@@ -66,6 +90,7 @@ class SimHand {
 
  private:
   HandParams params_;
+  const mjData* data_ = nullptr;
   int grip_site_ = -1;
   int grip_body_ = -1;
   int target_mocap_ = -1;
@@ -73,6 +98,13 @@ class SimHand {
   Vec3 force_N_ = Vec3::Zero();
   Vec3 torque_Nm_ = Vec3::Zero();
 };
+
+// The control callback the hands install (exposed for tests): applies the
+// hand registered for `d`, if any.
+void hand_control_callback(const mjModel* m, mjData* d);
+
+// The hand registered for `d`, or nullptr. Allocates nothing, takes no lock.
+SimHand* registered_hand(const mjData* d);
 
 }  // namespace vmh::sim
 
