@@ -14,9 +14,6 @@
 
 namespace vmh {
 
-// bit j set: VM joint j is held fixed (e.g. a sticking contact point)
-using JointMask = std::uint32_t;
-
 // Copies the columns of J whose bit in `locked` is clear into *out.
 void active_columns(const VmJacobian& J, JointMask locked, VmJacobian* out);
 

@@ -14,10 +14,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// tangential force below which a held contact never slips, whatever the
-// normal force: keeps rounding-level forces at rest from creeping the contact
-constexpr double kSlipFloor_N = 1e-6;
-
 void require(bool ok, const std::string& field, const std::string& what) {
   if (!ok) {
     throw std::invalid_argument("controller parameter " + field + ": " + what);
@@ -184,14 +180,11 @@ Controller::Controller(const ControllerParams& params) : params_(params) {
 }
 
 void Controller::reset() noexcept {
-  theta_v_ = vm_->zero_angles();
-  theta_r_ = vm_->zero_angles();
+  // the surface's probe starts upright; its first tick slides the contact
+  // under the stylus
+  theta_v_ = vm_->rest_angles();
+  theta_r_ = vm_->rest_angles();
   seed_ = vm_->zero_angles();
-  if (vm_->kind() == VmKind::kSurface) {
-    // probe upright; the first tick slides the contact under the stylus
-    theta_v_[2] = theta_v_[3] = 0.5 * kPi;
-    theta_r_ = theta_v_;
-  }
   placed_ = false;
   have_previous_ = false;
   e_previous_.setZero();
@@ -201,12 +194,11 @@ void Controller::reset() noexcept {
 ControlStatus Controller::place(const RmPose& rm, JointMask locked,
                                 ControlOutput* out) noexcept {
   ControlStatus st = kStatusOk;
-  const bool surface_sliding =
-      vm_->kind() == VmKind::kSurface && (locked & 3u) == 0;
+  const bool contact_sliding = vm_->has_contact() && locked == 0u;
   // the closed form: nearest point (circle, sphere, sticking surface); for
   // a sliding surface the probe aligned with the stylus, tip on the plane
   seed_ = theta_v_;
-  const bool seed_ok = surface_sliding ? vm_->aligned(rm, &seed_)
+  const bool seed_ok = contact_sliding ? vm_->aligned(rm, &seed_)
                                        : vm_->nearest(rm, &seed_);
   if (!seed_ok) st |= kStatusRmAtPivot;
   if (!placed_ && seed_ok) theta_v_ = seed_;
@@ -276,76 +268,61 @@ ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
   return st;
 }
 
-ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept {
-  out->status = kStatusOk;
-  out->force_device_N.setZero();
-  out->force_base_N.setZero();
-  out->tau_dh_Nm.setZero();
-  out->tau_motor_Nm.setZero();
-  if (!q_dh.allFinite()) {
-    // a sensor fault: zero force, keep the warm start, restart e_dot
-    out->status = kStatusInvalidInput;
-    out->f_motion.setZero();
-    out->e.setZero();
-    out->e_dot.setZero();
-    have_previous_ = false;
-    return out->status;
-  }
-  ControlStatus st = kStatusOk;
-  const OmniParams& omni = params_.omni;
-  if (!omni_within_limits(omni, q_dh)) st |= kStatusOutsideJointLimits;
+ControlStatus Controller::fail_input(ControlOutput* out) noexcept {
+  // a sensor fault: zero force, keep the warm start, restart e_dot
+  out->status = kStatusInvalidInput;
+  out->f_motion.setZero();
+  out->e.setZero();
+  out->e_dot.setZero();
+  have_previous_ = false;
+  return out->status;
+}
 
-  // 1. the RM: wrist centre and stylus axis in the device frame
+RmPose Controller::rm_pose(const Joints& q_dh, ControlOutput* out) const noexcept {
+  const OmniParams& omni = params_.omni;
   const OmniPose pose = omni_fk(omni, q_dh);
   out->p_rm_mm = base_to_device_mm(omni, pose.p_base_m);
   out->axis_rm = base_to_device_vector(pose.R_base.col(2));
   RmPose rm;
   rm.p = out->p_rm_mm / params_.length_unit_mm;
   rm.axis = out->axis_rm;
+  return rm;
+}
 
-  // 2. theta_R: the VM aligned with the stylus (kept where undefined)
-  if (!vm_->aligned(rm, &theta_r_)) st |= kStatusOrientationDegenerate;
-
-  // 3-4. placement, error and projected force. The surface with friction
-  // first tries its contact point held (prismatic joints locked) and slides
-  // only if the contact force leaves the friction cone.
-  const bool surface = vm_->kind() == VmKind::kSurface;
-  const double mu = params_.vm.friction_mu;
-  JointMask locked = (surface && mu > 0.0) ? 3u : 0u;
+ControlStatus Controller::evaluate_with_contact(const RmPose& rm,
+                                                ControlOutput* out) noexcept {
+  // A VM with a contact and friction first tries its contact held (the
+  // stick joints locked) and slides only if the force leaves the friction
+  // cone; a unilateral contact that would pull opens instead.
+  const VmParams& vm = params_.vm;
+  if (!vm_->has_contact()) return evaluate(rm, 0u, out);
+  const JointMask locked = vm.friction_mu > 0.0 ? vm_->stick_joints() : 0u;
   // first touch: the contact point under the stylus tip
-  if (surface && !placed_) vm_->aligned(rm, &theta_v_);
+  if (!placed_) vm_->aligned(rm, &theta_v_);
   const VmAngles held = theta_v_;
-  ControlStatus st_eval = evaluate(rm, locked, out);
-  if (surface) {
-    const Vec3 n = static_cast<const SurfaceVm&>(*vm_).normal();
-    const Vec3 f = out->f_motion.head<3>();
-    const double f_n = f.dot(n);
-    const double f_t = (f - f_n * n).norm();
-    if (params_.vm.unilateral && f_n < 0.0) {
+  ControlStatus st = evaluate(rm, locked, out);
+  switch (vm_->contact_state(out->f_motion.head<3>(), vm.friction_mu,
+                             vm.unilateral, locked != 0u)) {
+    case ContactState::kClosed:
+      break;
+    case ContactState::kOpen:
       // the plane can only push: the probe lifts off and follows the stylus
-      st |= kStatusContactOpen;
       vm_->aligned(rm, &theta_v_);
       out->f_motion.setZero();
-    } else if (locked != 0 && f_t > mu * std::abs(f_n) + kSlipFloor_N) {
+      st |= kStatusContactOpen;
+      break;
+    case ContactState::kSliding:
       theta_v_ = held;
-      st_eval = evaluate(rm, 0u, out) | kStatusContactSliding;
-    }
+      st = evaluate(rm, 0u, out) | kStatusContactSliding;
+      break;
   }
-  st |= st_eval;
-  placed_ = true;
-  e_previous_ = out->e;
-  e_dot_filtered_ = out->e_dot;
-  have_previous_ = true;
-  out->theta_v = theta_v_;
-  out->theta_r = theta_r_;
+  return st;
+}
 
-  // 5. the device force and joint torques
-  if (!out->f_motion.allFinite() || !out->e.allFinite()) {
-    out->status = st | kStatusNumericalFault;
-    out->f_motion.setZero();
-    reset();
-    return out->status;
-  }
+ControlStatus Controller::saturate_and_map(const Joints& q_dh,
+                                           ControlOutput* out) const noexcept {
+  ControlStatus st = kStatusOk;
+  const OmniParams& omni = params_.omni;
   Vec3 F = out->f_motion.head<3>();
   const double F_norm = F.norm();
   if (F_norm > params_.force_limit_N) {
@@ -357,9 +334,8 @@ ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept 
   Vec3 F_base = device_to_base_vector(F);
   const Mat6 Jr = omni_jacobian(omni, q_dh);
   Vec3 tau = Jr.topLeftCorner<3, 3>().transpose() * F_base;
-  // motors: t1 = -q1, t2 = q2, t3 = q2 + q3 (the third motor drives the
-  // absolute forearm angle); equal power gives these torques
-  Vec3 tau_motor(-tau[0], tau[1] - tau[2], tau[2]);
+  Vec3 tau_motor = dh_to_motor_torques(tau);
+  // one scale for every motor over its limit keeps the force's direction
   double scale = 1.0;
   for (int i = 0; i < kOmniActuated; ++i) {
     const double lim = omni.motor_torque_limit_Nm[static_cast<std::size_t>(i)];
@@ -378,6 +354,40 @@ ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept 
   out->force_base_N = F_base;
   out->tau_dh_Nm = tau;
   out->tau_motor_Nm = tau_motor;
+  return st;
+}
+
+ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept {
+  out->status = kStatusOk;
+  out->force_device_N.setZero();
+  out->force_base_N.setZero();
+  out->tau_dh_Nm.setZero();
+  out->tau_motor_Nm.setZero();
+  if (!q_dh.allFinite()) return fail_input(out);
+  ControlStatus st = kStatusOk;
+  if (!omni_within_limits(params_.omni, q_dh)) st |= kStatusOutsideJointLimits;
+
+  // 1. the RM: wrist centre and stylus axis in the device frame
+  const RmPose rm = rm_pose(q_dh, out);
+  // 2. theta_R: the VM aligned with the stylus (kept where undefined)
+  if (!vm_->aligned(rm, &theta_r_)) st |= kStatusOrientationDegenerate;
+  // 3-4. placement, error and projected force
+  st |= evaluate_with_contact(rm, out);
+  placed_ = true;
+  e_previous_ = out->e;
+  e_dot_filtered_ = out->e_dot;
+  have_previous_ = true;
+  out->theta_v = theta_v_;
+  out->theta_r = theta_r_;
+
+  // 5. the device force and joint torques
+  if (!out->f_motion.allFinite() || !out->e.allFinite()) {
+    out->status = st | kStatusNumericalFault;
+    out->f_motion.setZero();
+    reset();
+    return out->status;
+  }
+  st |= saturate_and_map(q_dh, out);
   out->status = st;
   return st;
 }

@@ -185,6 +185,17 @@ class Controller {
   // place, then e, e_dot and f_motion into *out
   ControlStatus evaluate(const RmPose& rm, JointMask locked,
                          ControlOutput* out) noexcept;
+  // evaluate, and for a VM with a contact, hold, slide or open it
+  ControlStatus evaluate_with_contact(const RmPose& rm,
+                                      ControlOutput* out) noexcept;
+  // the RM's pose from the DH joints (also into *out's p_rm_mm, axis_rm)
+  RmPose rm_pose(const Joints& q_dh, ControlOutput* out) const noexcept;
+  // rows 0-2 of f_motion saturated to the force limit, tau = J_r^T F
+  // (eq. 3.12), the motor torques scaled into their limits
+  ControlStatus saturate_and_map(const Joints& q_dh,
+                                 ControlOutput* out) const noexcept;
+  // a non-finite joint angle: zero output, restart e_dot
+  ControlStatus fail_input(ControlOutput* out) noexcept;
 
   ControllerParams params_;
   std::unique_ptr<VirtualMechanism> vm_;

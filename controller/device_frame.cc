@@ -24,6 +24,14 @@ Joints dh_to_device_joints(const Joints& q) {
   return t;
 }
 
+Vec3 dh_to_motor_torques(const Vec3& tau) {
+  return Vec3(-tau[0], tau[1] - tau[2], tau[2]);
+}
+
+Vec3 motor_to_dh_torques(const Vec3& m) {
+  return Vec3(-m[0], m[1] + m[2], m[2]);
+}
+
 Mat3 R_device_base() {
   Mat3 R;
   // rows: x_dev = y_base, y_dev = z_base, z_dev = x_base

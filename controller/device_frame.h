@@ -37,6 +37,14 @@ namespace vmh {
 Joints device_to_dh_joints(const Joints& q_device);
 Joints dh_to_device_joints(const Joints& q_dh);
 
+// Torques on the three actuated joints: DH joints q1..q3 <-> motors t1..t3,
+// N m. The motors drive t1..t3 (t3 the absolute forearm angle), so by equal
+// power (tau_dh . dq = tau_motor . dt under the joint map above) the motor
+// torques are (-tau1, tau2 - tau3, tau3), and back tau_dh =
+// (-m1, m2 + m3, m3).
+Vec3 dh_to_motor_torques(const Vec3& tau_dh_Nm);
+Vec3 motor_to_dh_torques(const Vec3& tau_motor_Nm);
+
 // Rotation taking DH base-frame components to device-frame components.
 Mat3 R_device_base();
 

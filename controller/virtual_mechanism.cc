@@ -85,6 +85,68 @@ VmAngles VirtualMechanism::zero_angles() const {
   return VmAngles::Zero(dof());
 }
 
+ContactState VirtualMechanism::contact_state(const Vec3&, double, bool,
+                                             bool) const {
+  return ContactState::kClosed;
+}
+
+double CircleVm::distance_to_path(const Vec3& p) const {
+  const Vec3 r = mount_.R.transpose() * (p - mount_.origin);
+  const double rho = std::hypot(r.x(), r.y());
+  return std::hypot(rho - length_, r.z());
+}
+
+Vec3 CircleVm::nearest_on_path(const Vec3& p) const {
+  Vec3 r = mount_.R.transpose() * (p - mount_.origin);
+  r.z() = 0.0;
+  if (r.norm() < 1e-12) return mount_.origin;
+  return mount_.origin + mount_.R * (length_ * r.normalized());
+}
+
+double SphereVm::distance_to_path(const Vec3& p) const {
+  const Vec3 r = mount_.R.transpose() * (p - mount_.origin);
+  return std::abs(r.norm() - length_);
+}
+
+Vec3 SphereVm::nearest_on_path(const Vec3& p) const {
+  const Vec3 r = mount_.R.transpose() * (p - mount_.origin);
+  if (r.norm() < 1e-12) return mount_.origin;
+  return mount_.origin + mount_.R * (length_ * r.normalized());
+}
+
+double SurfaceVm::distance_to_path(const Vec3& p) const {
+  const Vec3 r = mount_.R.transpose() * (p - mount_.origin);
+  return std::abs(std::abs(r.z()) - length_);
+}
+
+Vec3 SurfaceVm::nearest_on_path(const Vec3& p) const {
+  Vec3 r = mount_.R.transpose() * (p - mount_.origin);
+  r.z() = r.z() >= 0.0 ? length_ : -length_;
+  return mount_.origin + mount_.R * r;
+}
+
+ContactState SurfaceVm::contact_state(const Vec3& f_N, double mu,
+                                      bool unilateral, bool sticking) const {
+  // tangential force below which a held contact never slips, whatever the
+  // normal force: keeps rounding-level forces at rest from creeping the
+  // contact
+  constexpr double kSlipFloor_N = 1e-6;
+  const Vec3 n = normal();
+  const double f_n = f_N.dot(n);
+  const double f_t = (f_N - f_n * n).norm();
+  if (unilateral && f_n < 0.0) return ContactState::kOpen;
+  if (sticking && f_t > mu * std::abs(f_n) + kSlipFloor_N) {
+    return ContactState::kSliding;
+  }
+  return ContactState::kClosed;
+}
+
+VmAngles SurfaceVm::rest_angles() const {
+  VmAngles theta = zero_angles();
+  theta[2] = theta[3] = 0.5 * kPi;
+  return theta;
+}
+
 Vec3 VirtualMechanism::geometric_orientation_error(const VmPose& vm,
                                                    const RmPose& rm,
                                                    bool* ambiguous) const {

@@ -29,6 +29,7 @@
 #ifndef VMHAPTICS_CONTROLLER_VIRTUAL_MECHANISM_H_
 #define VMHAPTICS_CONTROLLER_VIRTUAL_MECHANISM_H_
 
+#include <cstdint>
 #include <limits>
 
 #include "controller/types.h"
@@ -44,6 +45,16 @@ using VmJacobian =
     Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::ColMajor, 6, kMaxVmDof>;
 
 enum class VmKind { kCircle, kSphere, kSurface };
+
+// a set of VM joints, bit j for joint j (e.g. locked during placement)
+using JointMask = std::uint32_t;
+
+// What a contact does under the force the control law asks for.
+enum class ContactState {
+  kClosed,   // the contact holds (sticks, or slides freely without friction)
+  kSliding,  // it sticks no longer: the force left the friction cone
+  kOpen,     // unilateral contact pulled on: the probe lifts off
+};
 
 // "circle", "sphere", "surface"
 const char* vm_kind_name(VmKind kind);
@@ -131,8 +142,31 @@ class VirtualMechanism {
   // polar angle to [0, pi]) without moving the handle
   virtual void normalize(VmAngles* theta) const = 0;
 
+  // The VM's path in closed form, device frame, the caller's length unit:
+  // the circle or the sphere the handle moves on; for the surface, the
+  // handle positions with the probe upright (the two planes L from the
+  // plane). distance_to_path is the distance from p to it; nearest_on_path
+  // the point of it nearest p (at the pivot, where every point is nearest,
+  // the pivot itself).
+  virtual double distance_to_path(const Vec3& p) const = 0;
+  virtual Vec3 nearest_on_path(const Vec3& p) const = 0;
+
+  // Contact with the environment the VM stands for: none by default; the
+  // surface's probe touches its plane. stick_joints() are the joints held
+  // while the contact sticks (the surface's prismatic pair); contact_state()
+  // says what the contact does under f_N, the force the law asks for
+  // (device frame, N), with Coulomb coefficient mu and, if `unilateral`,
+  // a contact that can only push; `sticking` says whether stick_joints()
+  // were held when f_N was computed.
+  virtual bool has_contact() const { return false; }
+  virtual JointMask stick_joints() const { return 0u; }
+  virtual ContactState contact_state(const Vec3& f_N, double mu,
+                                     bool unilateral, bool sticking) const;
+
   // a VmAngles of size dof(), zero
   VmAngles zero_angles() const;
+  // the angles before any placement (zero, or the surface's upright probe)
+  virtual VmAngles rest_angles() const { return zero_angles(); }
 
   const VmMount& mount() const { return mount_; }
   double length() const { return length_; }
@@ -159,6 +193,8 @@ class CircleVm final : public VirtualMechanism {
                                   const RmPose& rm) const override;
   bool is_revolute(int) const override { return true; }
   void normalize(VmAngles* theta) const override;
+  double distance_to_path(const Vec3& p) const override;
+  Vec3 nearest_on_path(const Vec3& p) const override;
 };
 
 class SphereVm final : public VirtualMechanism {
@@ -174,6 +210,8 @@ class SphereVm final : public VirtualMechanism {
                                 const VmAngles& theta_r) const override;
   bool is_revolute(int) const override { return true; }
   void normalize(VmAngles* theta) const override;
+  double distance_to_path(const Vec3& p) const override;
+  Vec3 nearest_on_path(const Vec3& p) const override;
 };
 
 // The plane passes through mount.origin with normal mount.R.col(2); the
@@ -198,6 +236,21 @@ class SurfaceVm final : public VirtualMechanism {
                                 const VmAngles& theta_r) const override;
   bool is_revolute(int joint) const override { return joint >= 2; }
   void normalize(VmAngles* theta) const override;
+  // the handle positions with the probe upright: L above or below the plane
+  double distance_to_path(const Vec3& p) const override;
+  Vec3 nearest_on_path(const Vec3& p) const override;
+  bool has_contact() const override { return true; }
+  // the prismatic joints s1, s2: the contact point
+  JointMask stick_joints() const override { return 3u; }
+  // kOpen if unilateral and f_N . n < 0 (the plane would have to pull the
+  // probe toward it; the handle stands on the +n side); kSliding if
+  // sticking and the tangential part exceeds mu |f_n| (plus a floor of
+  // 1e-6 N that keeps rounding-level forces at rest from creeping the
+  // contact); kClosed otherwise
+  ContactState contact_state(const Vec3& f_N, double mu, bool unilateral,
+                             bool sticking) const override;
+  // the probe upright (alpha = beta = pi/2), the contact at the origin
+  VmAngles rest_angles() const override;
 
   // the contact point (device frame) for theta
   Vec3 contact(const VmAngles& theta) const;

@@ -235,39 +235,15 @@ void ClosedLoop::set_hand_target(double t_s) {
   hand_->set_target(m, data_.get(), target);
 }
 
+// the mechanism works in the controller's length unit
 double ClosedLoop::distance_to_path_mm(const Vec3& p_mm) const {
-  const VmParams& vm = params_.vm;
-  const Vec3 r = vm.R_pivot.transpose() * (p_mm - vm.pivot_mm);
-  switch (vm.kind) {
-    case VmKind::kCircle: {
-      const double rho = std::hypot(r.x(), r.y());
-      return std::hypot(rho - vm.length_mm, r.z());
-    }
-    case VmKind::kSphere:
-      return std::abs(r.norm() - vm.length_mm);
-    case VmKind::kSurface:
-      // the handle stays L from the plane when the probe is upright
-      return std::abs(std::abs(r.z()) - vm.length_mm);
-  }
-  return 0.0;
+  const double u = params_.length_unit_mm;
+  return controller_->mechanism().distance_to_path(p_mm / u) * u;
 }
 
 Vec3 ClosedLoop::nearest_on_path_mm(const Vec3& p_mm) const {
-  const VmParams& vm = params_.vm;
-  Vec3 r = vm.R_pivot.transpose() * (p_mm - vm.pivot_mm);
-  switch (vm.kind) {
-    case VmKind::kCircle:
-      r.z() = 0.0;
-      break;
-    case VmKind::kSphere:
-      break;
-    case VmKind::kSurface:
-      r.z() = r.z() >= 0.0 ? vm.length_mm : -vm.length_mm;
-      return vm.pivot_mm + vm.R_pivot * r;
-  }
-  // at the pivot every point of the path is nearest; keep the pivot
-  if (r.norm() < 1e-12) return vm.pivot_mm;
-  return vm.pivot_mm + vm.R_pivot * (vm.length_mm * r.normalized());
+  const double u = params_.length_unit_mm;
+  return controller_->mechanism().nearest_on_path(p_mm / u) * u;
 }
 
 void ClosedLoop::tick(TraceRow* row) {

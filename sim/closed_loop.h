@@ -143,7 +143,8 @@ class ClosedLoop {
   void set_hand_target(double t_s);
 
   // distance (mm) from a device-frame point to the VM's path: the circle,
-  // the sphere or the plane, in closed form
+  // the sphere or the plane, in closed form (VirtualMechanism::
+  // distance_to_path)
   double distance_to_path_mm(const Vec3& p_mm) const;
   // the point of the VM's path nearest a device-frame point, closed form
   // (for the surface: the point L above the plane over it)

@@ -35,6 +35,27 @@ TEST(DeviceJoints, JointThreeIsAbsoluteAndJointsOneFourSixReversed) {
 }
 
 // the stylus frame at q = 0 is the device frame itself
+// The torque map is the joint map's inverse transpose: for any joint motion
+// dt (device convention) and its DH image dq = device_to_dh_joints(t + dt) -
+// device_to_dh_joints(t), the motors' power equals the DH joints' power.
+TEST(DeviceTorques, EqualPowerUnderTheJointMap) {
+  JointSampler sample(22);
+  for (int k = 0; k < 1000; ++k) {
+    const Joints t = sample.next();
+    const Joints dt = 1e-3 * sample.next();
+    const Joints dq = device_to_dh_joints(t + dt) - device_to_dh_joints(t);
+    const Vec3 tau_dh = sample.next().head<3>();
+    const Vec3 tau_motor = dh_to_motor_torques(tau_dh);
+    // dq is a difference of angles near 1 rad: rounding about 1e-16 each
+    EXPECT_NEAR(tau_motor.dot(dt.head<3>()), tau_dh.dot(dq.head<3>()), 1e-14);
+    EXPECT_LE((motor_to_dh_torques(tau_motor) - tau_dh).norm(), 1e-15);
+  }
+  // the third motor carries the absolute forearm torque: a pure q3 torque
+  // loads motors 2 and 3 in opposite senses
+  EXPECT_EQ(dh_to_motor_torques(Vec3(0, 0, 1)), Vec3(0, -1, 1));
+  EXPECT_EQ(dh_to_motor_torques(Vec3(1, 0, 0)), Vec3(-1, 0, 0));
+}
+
 TEST(DeviceFrame, StylusFrameAtHomeIsTheDeviceFrame) {
   const OmniParams p;
   const Mat3 R = base_to_device_rotation(omni_fk(p, Joints::Zero()).R_base);
