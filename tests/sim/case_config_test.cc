@@ -418,7 +418,7 @@ TEST_F(CaseConfigTest, ControllerParamsMapEveryField) {
   EXPECT_NO_THROW(p.validate());
 }
 
-// The thesis's own numbers (REFERENCE.md §1): L = 50 mm, multiple 1 gives
+// The thesis's own numbers (docs/sources.md §2): L = 50 mm, multiple 1 gives
 // 2 pi 50 = 314.159... N mm/rad; the defaults give case 1's parameters.
 TEST_F(CaseConfigTest, ControllerParamsOfTheThesisDefaults) {
   ControllerParams p = controller_params(load(kCircle));

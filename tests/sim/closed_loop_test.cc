@@ -128,7 +128,7 @@ TEST(ClosedLoopTest, StartsOnThePathWithTheScriptedStylus) {
 
 // The reading path: with quantisation on, the controller's wrist centre is
 // within the encoders' resolution of the truth (0.056 mm per count at the
-// tip, REFERENCE.md §3; three joints, so a few counts' worth), and exact with
+// tip, docs/sources.md §6; three joints, so a few counts' worth), and exact with
 // it off.
 TEST(ClosedLoopTest, SensorModelSitsBetweenTruthAndController) {
   testing::MujocoGuard guard;
