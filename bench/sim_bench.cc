@@ -1,7 +1,7 @@
 // The cost of the closed loop (sim/closed_loop.h) against bare MuJoCo on the
 // same model, and the wall time of `vmhaptics run --all`.
 //
-// Issue 4's goals, reported in README.md (never asserted as timed tests):
+// Issue 4's goals, reported in docs/testing.md (never asserted as timed tests):
 // - the loop costs at most 25% over bare mj_step per physics step;
 // - all six cases, 20 simulated seconds each, in under 10 s on 2 cores.
 //

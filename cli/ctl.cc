@@ -1,6 +1,6 @@
 // `vmhaptics ctl ...`: the virtual-mechanism controller (thesis ch. 3) run
 // at one joint configuration, as one JSON object on stdout. The field names
-// and units are a contract documented in README.md.
+// and units are a contract documented in docs/outputs.md.
 //
 // The controller is ticked --ticks times on the same q (the warm start of
 // the Gauss-Newton placement is what repeats); the last tick is printed.

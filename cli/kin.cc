@@ -1,6 +1,6 @@
 // `vmhaptics kin ...`: forward kinematics, Jacobian, inverse kinematics and
 // the device parameters of the PHANTOM Omni, as one JSON object on stdout.
-// The field names and units are a contract documented in README.md.
+// The field names and units are a contract documented in docs/outputs.md.
 #include "cli/kin.h"
 
 #include <Eigen/SVD>

@@ -136,7 +136,7 @@ void register_run(CLI::App* app) {
                   "write DIR/<case>/trace.csv and DIR/<case>/summary.json");
   cmd->add_option("--set", o->sets,
                   "override a case parameter, name=value (vectors "
-                  "comma-separated); repeatable. README.md lists the names")
+                  "comma-separated); repeatable. docs/cli.md lists the names")
       ->allow_extra_args(false);
   cmd->add_option("--jobs", o->jobs,
                   "cases run in parallel (default: one per core)");

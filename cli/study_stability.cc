@@ -8,7 +8,7 @@
 // The critical stiffness of a virtual wall rendered at period T with a
 // zero-order hold on a 1-DOF slider (models/slider/slider.xml) simulated in
 // MuJoCo at h << T, found by bisection on whether the oscillation grows,
-// against theory (sim/stability_study.h, REFERENCE.md §6). Prints one JSON
+// against theory (studies/stability_study.h, docs/sources.md §11). Prints one JSON
 // object. With --out DIR: DIR/stability_bisection.csv (every run of the
 // bisection) and DIR/stability_bisection.svg (their growth rates against K
 // with the theories' K marked); with --map: DIR/stability_map.csv and

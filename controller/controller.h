@@ -17,7 +17,7 @@
 // Units. The controller's length unit is `length_unit_mm` (1 mm by default,
 // as in the thesis): e rows 0-2, X_V and J_V's translational rows are in it,
 // e rows 3-5 in rad; f_motion rows 0-2 in N and rows 3-5 in N x length unit.
-// The projection is not invariant to this unit (REFERENCE.md §2): J_V^T J_V
+// The projection is not invariant to this unit (docs/sources.md §3): J_V^T J_V
 // adds length^2 to 1. Gains are stored in physical units (N/mm, N mm/rad)
 // and converted, so a change of unit changes only the projection.
 //
@@ -108,7 +108,7 @@ struct Gains {
 };
 
 // eq. 3.28: K_ornt = multiple x 2 pi L. The thesis's cases use multiples
-// 0, 0.5 and 1 (REFERENCE.md §1) with L = 50 mm; the multiple carries the
+// 0, 0.5 and 1 (docs/sources.md §2) with L = 50 mm; the multiple carries the
 // position gain's unit, N/mm, so K_ornt is in N mm/rad.
 double thesis_orientation_gain(double multiple_N_per_mm, double length_mm);
 

@@ -6,7 +6,7 @@
 // user; positions in mm. OpenHaptics reports joint 3 as the absolute forearm
 // angle, and turns joints 1, 4 and 6 the other way round from the DH angles.
 //
-// How the mapping was found (REFERENCE.md §3, checked in
+// How the mapping was found (docs/sources.md §4, checked in
 // tests/controller/device_frame_test.cc): the OpenHaptics forward kinematics
 //   x = -sin t1 (l1 cos t2 + l2 sin t3)
 //   y = l2 - l2 cos t3 + l1 sin t2
@@ -14,7 +14,7 @@
 // equals eq. B.14 under
 //   q1 = -t1, q2 = t2, q3 = t3 - t2,
 //   x_dev = y_base, y_dev = z_base - l0 + l2, z_dev = x_base - l1.
-// This rotation is proper (det +1). REFERENCE.md instead pairs x_dev = -y_base
+// This rotation is proper (det +1). A first derivation paired x_dev = -y_base
 // with q1 = t1, which fits the positions too but is a reflection (det -1): it
 // would turn the stylus frame left-handed. See docs/errata.md.
 //

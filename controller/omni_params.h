@@ -26,7 +26,7 @@ inline constexpr int kOmniActuated = 3;
 struct OmniParams {
   // -- geometry (Table B.1) --
   // height of joint 2 above the DH base; the base frame sits at the shoulder,
-  // so 0 [REFERENCE.md §3]
+  // so 0 [docs/sources.md §4]
   double l0_m = 0.0;
   // upper arm, shoulder axis to elbow axis [ubitrack]
   double l1_m = 0.13335;

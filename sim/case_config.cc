@@ -114,7 +114,7 @@ const std::vector<FieldSpec>& case_fields() {
        "step; each tick's is drawn uniformly among them, and the controller "
        "is still told servo_period_s. 0 0: every period is servo_period_s. The extreme "
        "cases use 0.4e-3 2.8e-3: 2.8 ms is a USB Touch's worst case, the "
-       "range far wider than its measured spread (REFERENCE.md 3)"},
+       "range far wider than its measured spread (docs/sources.md 6)"},
       {"jitter_seed", false, 1, "1", "-",
        "seed of the servo-period draws (whole number)"},
       {"fault", true, 1, "none", "-",

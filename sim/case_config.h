@@ -3,7 +3,7 @@
 // validated at setup time.
 //
 // Every parameter the simulator knows is listed once, in case_fields(), with
-// its size, default, unit and meaning; README.md prints the same table. A
+// its size, default, unit and meaning; docs/cli.md prints the same table. A
 // scene that carries a <custom> field not in the list, a `--set` of an
 // unknown name, a value of the wrong size, or a missing required field is an
 // error that names the file and the field.

@@ -9,7 +9,7 @@
 //   F   = K_p (p_target - p_grip) + B_p (v_target - v_grip)
 //   tau = K_r r(R_target R_grip^T) + B_r (w_target - w_grip)
 // with r(.) the rotation vector, all in the world (DH base) frame, SI units.
-// Parameters: models/hand/README.md (REFERENCE.md §5).
+// Parameters: models/hand/README.md (docs/sources.md §10).
 //
 // Who computes the wrench: MuJoCo's global mjcb_control, whose one owner is
 // this file. The first SimHand installs hand_control_callback() there; each

@@ -1,7 +1,7 @@
 // What the Omni's sensors make of the true joint angles: the three actuated
 // joints through optical encoders of 15000 counts per revolution, the three
 // gimbal joints through potentiometers read with 11 valid bits
-// (OmniParams, REFERENCE.md §3). Angles in the device convention, rad.
+// (OmniParams, docs/sources.md §6). Angles in the device convention, rad.
 #ifndef VMHAPTICS_SIM_SENSOR_MODEL_H_
 #define VMHAPTICS_SIM_SENSOR_MODEL_H_
 

@@ -117,7 +117,7 @@ RunMetrics run_metrics(const std::vector<TraceRow>& rows,
 std::optional<ControllerParams> reference_params(int thesis_case,
                                                  const ControllerParams& p) {
   if (thesis_case != 3 && thesis_case != 4) return std::nullopt;
-  // case 2: K_pos 0.5 N/mm, K_ornt 0.5 x 2 pi L (REFERENCE.md §1)
+  // case 2: K_pos 0.5 N/mm, K_ornt 0.5 x 2 pi L (docs/sources.md §2)
   ControllerParams ref = p;
   ref.gains.k_pos_N_per_mm = 0.5;
   ref.gains.k_ornt_Nmm_per_rad = thesis_orientation_gain(0.5, p.vm.length_mm);

@@ -1,4 +1,4 @@
-// The thesis's claims (ch. 4, REFERENCE.md §1) as measured numbers on a
+// The thesis's claims (ch. 4, docs/sources.md §2) as measured numbers on a
 // closed-loop run, and the run's metrics.
 //
 // Each claim names what it measures, over which part of the hand script

@@ -30,7 +30,7 @@ namespace vmh::sim {
 
 // MuJoCo 2.2.2's integrators: mjINT_EULER (semi-implicit, joint damping
 // implicit), mjINT_RK4 (needs mj_step: mj_step2 falls back to Euler), and
-// mjINT_IMPLICIT (implicit in velocity). REFERENCE.md §7.
+// mjINT_IMPLICIT (implicit in velocity). docs/sources.md §12.
 enum class Integrator { kEuler, kImplicit, kRk4 };
 
 // "euler", "implicit", "rk4": the case field `integrator`'s values

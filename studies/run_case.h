@@ -2,7 +2,7 @@
 // (one row per servo tick), DIR/<case>/summary.json (metrics and the
 // thesis's claims), and the plots views.svg and history.svg (plot_svg.h).
 // Each is written to a temporary name and renamed, so a failed run leaves
-// nothing half-written. README.md documents the formats.
+// nothing half-written. docs/outputs.md documents the formats.
 #ifndef VMHAPTICS_STUDIES_RUN_CASE_H_
 #define VMHAPTICS_STUDIES_RUN_CASE_H_
 

@@ -1,6 +1,6 @@
 // The stability study (`vmhaptics study stability`): the critical stiffness
 // of a sampled-data virtual wall, found by simulation in MuJoCo and checked
-// against theory (REFERENCE.md §6).
+// against theory (docs/sources.md §11).
 //
 // The scene is models/slider/slider.xml: a 1-DOF slider of mass m with
 // viscous damping b (joint damping), pushed by a motor. A controller sampled

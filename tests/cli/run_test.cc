@@ -35,7 +35,7 @@ TEST(RunCli, WritesTraceAndSummary) {
     EXPECT_EQ(first_line(out / "case1" / svg).rfind("<svg", 0), 0u) << svg;
   }
 
-  // the documented columns, in order (README.md, "trace.csv")
+  // the documented columns, in order (docs/outputs.md, "trace.csv")
   const std::string header = first_line(out / "case1" / "trace.csv");
   EXPECT_EQ(header.rfind("t_s,q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad,"
                          "p_x_mm,p_y_mm,p_z_mm,a_x,a_y,a_z,theta_v_1,"

@@ -1,6 +1,6 @@
 // The Controller end to end, from joint angles to device force and torques.
 //
-// The thesis's claims (REFERENCE.md §1, thesis ch. 4) are checked as numbers
+// The thesis's claims (docs/sources.md §2, thesis ch. 4) are checked as numbers
 // on static configurations. Each configuration is built from a wanted wrist
 // centre and stylus axis in the device frame through the inverse kinematics,
 // and the expected forces are written out by hand from the geometry of the

@@ -68,7 +68,7 @@ TEST(DeviceFrame, RotationIsProper) {
   EXPECT_DOUBLE_EQ(R.determinant(), 1.0);
 }
 
-// device axes named in REFERENCE.md §3: y up is base z; z toward the user is
+// device axes named in docs/sources.md §4: y up is base z; z toward the user is
 // base x (the arm's direction at q1 = 0)
 TEST(DeviceFrame, AxesPointWhereTheDocsSay) {
   EXPECT_EQ(base_to_device_vector(Vec3::UnitZ()), Vec3::UnitY());

@@ -11,7 +11,7 @@
 //     transforms RotX(alpha) TransX(a) RotZ(theta) TransZ(d) (Craig's
 //     definition of the modified-DH link, not eq. 2.1 typed out);
 //   - central finite differences of that chain (Jacobian);
-//   - the OpenHaptics closed form of REFERENCE.md §3 (frame mapping);
+//   - the OpenHaptics closed form of docs/sources.md §4 (frame mapping);
 //   - determinants and orthogonality (what any rotation must satisfy).
 // docs/errata.md lists each erratum with the name of the test that shows it.
 #include <gtest/gtest.h>
@@ -549,12 +549,12 @@ TEST(Errata, EqB54J45Sign) {
 }
 
 // ===========================================================================
-// REFERENCE.md §3 frame mapping: x_HD = -y_DH, y_HD = z_DH + l2,
+// first derived frame mapping (docs/sources.md §4): x_HD = -y_DH, y_HD = z_DH + l2,
 // z_HD = x_DH - l1 with q1 = t1 fits the OpenHaptics positions, but its
 // rotation has det -1; the project's R_device_base() (x_HD = +y_DH with
 // q1 = -t1) has det +1 and fits them too.
 TEST(FrameMapping, ReferenceMappingIsAReflectionProjectsIsARotation) {
-  OmniParams p;  // L0 = 0, as REFERENCE.md §3 assumes
+  OmniParams p;  // L0 = 0, as docs/sources.md §4 assumes
   const double l1 = 1e3 * p.l1_m, l2 = 1e3 * p.l2_m;
   Mat3 R_ref;
   R_ref << 0, -1, 0,  //
@@ -574,7 +574,7 @@ TEST(FrameMapping, ReferenceMappingIsAReflectionProjectsIsARotation) {
     const Joints t = s.angles();  // OpenHaptics joint angles, t3 absolute
     const Vec3 hd = testing::openhaptics_wrist_mm(t, l1, l2);
 
-    // REFERENCE: q1 = t1, q2 = t2, q3 = t3 - t2
+    // first derivation: q1 = t1, q2 = t2, q3 = t3 - t2
     Joints q_ref = t;
     q_ref[2] = t[2] - t[1];
     const OmniPose pose_ref = omni_fk(p, q_ref);
@@ -594,7 +594,7 @@ TEST(FrameMapping, ReferenceMappingIsAReflectionProjectsIsARotation) {
   }
   EXPECT_LE(worst_ref, 1e-9);      // mm
   EXPECT_LE(worst_project, 1e-9);  // mm
-  // REFERENCE's mapping turns the stylus frame left-handed; the project's not
+  // the first derived mapping turns the stylus frame left-handed; the project's not
   EXPECT_LE(worst_det_stylus_ref, kExact);
   EXPECT_LE(worst_det_stylus_project, kExact);
 }

@@ -1,5 +1,5 @@
 // Checks of controller/omni_kinematics against routes that do not share its
-// code: the OpenHaptics closed form (REFERENCE.md §3), central finite
+// code: the OpenHaptics closed form (docs/sources.md §4), central finite
 // differences, and forward kinematics of the inverse solutions.
 // (MuJoCo's own kinematics are compared in omni_kinematics_mujoco_test.cc.)
 #include "controller/omni_kinematics.h"

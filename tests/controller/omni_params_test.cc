@@ -13,7 +13,7 @@ namespace {
 
 TEST(OmniParams, DefaultsAreValid) { EXPECT_NO_THROW(OmniParams{}.validate()); }
 
-// the Omni's published numbers (REFERENCE.md §3)
+// the Omni's published numbers (docs/sources.md §4-7)
 TEST(OmniParams, DefaultsAreTheOmnis) {
   const OmniParams p;
   EXPECT_DOUBLE_EQ(p.l1_m, 0.13335);

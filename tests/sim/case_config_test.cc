@@ -4,7 +4,7 @@
 //
 // The scenes are tiny MJCF files written for each test (no bodies, only a
 // <custom> block) and loaded by path with sim::load_model, as the simulator
-// loads a case. Expected values are the documented ones (README.md, "Case
+// loads a case. Expected values are the documented ones (docs/cli.md, "Case
 // parameters"; docs/testbed.md), written out here, not read from the field
 // table the loader uses.
 #include "sim/case_config.h"
@@ -75,7 +75,7 @@ TEST_F(CaseConfigTest, DefaultsFillEveryFieldTheSceneLeavesOut) {
   EXPECT_EQ(c.text("vm_kind"), "circle");
   EXPECT_EQ(c.source_of("vm_kind"), ValueSource::kScene);
 
-  // scalars: name, documented default (README.md, "Case parameters")
+  // scalars: name, documented default (docs/cli.md, "Case parameters")
   const std::vector<std::pair<const char*, double>> scalars = {
       {"thesis_case", 0.0},
       {"vm_length_mm", 50.0},
@@ -418,7 +418,7 @@ TEST_F(CaseConfigTest, ControllerParamsMapEveryField) {
   EXPECT_NO_THROW(p.validate());
 }
 
-// The thesis's own numbers (REFERENCE.md §1): L = 50 mm, multiple 1 gives
+// The thesis's own numbers (docs/sources.md §2): L = 50 mm, multiple 1 gives
 // 2 pi 50 = 314.159... N mm/rad; the defaults give case 1's parameters.
 TEST_F(CaseConfigTest, ControllerParamsOfTheThesisDefaults) {
   ControllerParams p = controller_params(load(kCircle));

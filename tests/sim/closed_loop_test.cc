@@ -129,7 +129,7 @@ TEST(ClosedLoopTest, StartsOnThePathWithTheScriptedStylus) {
 
 // The reading path: with quantisation on, the controller's wrist centre is
 // within the encoders' resolution of the truth (0.056 mm per count at the
-// tip, REFERENCE.md §3; three joints, so a few counts' worth), and exact with
+// tip, docs/sources.md §6; three joints, so a few counts' worth), and exact with
 // it off.
 TEST(ClosedLoopTest, SensorModelSitsBetweenTruthAndController) {
   testing::MujocoGuard guard;
@@ -180,10 +180,10 @@ TEST(ClosedLoopTest, NearestPointOnPathIsTheNearest) {
 namespace vmh::sim {
 namespace {
 
-// README.md's table of case parameters lists every field the loader knows
+// docs/cli.md's table of case parameters lists every field the loader knows
 // with its default, so the documented contract cannot drift from the code.
 TEST(CaseParameterDocs, ReadmeListsEveryField) {
-  std::ifstream in(std::string(VMH_MODELS_DIR) + "/../README.md");
+  std::ifstream in(std::string(VMH_MODELS_DIR) + "/../docs/cli.md");
   ASSERT_TRUE(in.good());
   std::stringstream text;
   text << in.rdbuf();
@@ -192,7 +192,7 @@ TEST(CaseParameterDocs, ReadmeListsEveryField) {
     const std::string row = std::string("| `") + f.name + "` | " +
                             (f.default_value ? f.default_value : "(required)") +
                             " | " + f.unit + " |";
-    EXPECT_NE(readme.find(row), std::string::npos) << "README.md lacks: " << row;
+    EXPECT_NE(readme.find(row), std::string::npos) << "docs/cli.md lacks: " << row;
   }
 }
 

@@ -379,7 +379,7 @@ TEST(ExtremeInstabilities, PositionLimitCycleFollowsColgate) {
 // the arm, a non-conservative coupling. It is not the sampling: it stays at
 // a 5 kHz servo rate and without quantisation; it goes with a stiffer wrist
 // (5 N m/rad) or a more damped one (0.1 N m s/rad). The wrist's values are
-// estimates (REFERENCE.md §5 found none published).
+// estimates (docs/sources.md §10 found none published).
 TEST(ExtremeInstabilities, OrientationGainFlutters) {
   testing::MujocoGuard guard;
   auto run = [](std::vector<std::string> extra) {

@@ -1,6 +1,6 @@
 // sim/stability_study.cc: the critical stiffness of the sampled-data wall,
-// found by simulating the slider in MuJoCo, against theory (REFERENCE.md
-// §6):
+// found by simulating the slider in MuJoCo, against theory (docs/sources.md
+// §11):
 //   - Gil et al. 2004: K_crit = (b + B)/(T/2 + n T), within 5%, where that
 //     first-order bound is expected to hold: bT/m and BT/m small (the
 //     exact discrete loop puts its error at about +bT/(6m) and -BT/m for

@@ -25,7 +25,7 @@ double max_abs_diff(const Eigen::MatrixBase<A>& a,
 }
 
 // puts q into qpos and runs the position stages mj_jacSite depends on:
-// frames, then the com-based quantities (REFERENCE.md §7)
+// frames, then the com-based quantities (docs/sources.md §12)
 inline void set_joints(const mjModel* m, mjData* d, const Joints& q) {
   for (int i = 0; i < kOmniJoints; ++i) d->qpos[i] = q[i];
   mj_kinematics(m, d);

@@ -1,5 +1,5 @@
 // OpenHaptics forward kinematics written out from its published form, as a
-// reference that shares no code with controller/ (REFERENCE.md §3).
+// reference that shares no code with controller/ (docs/sources.md §4).
 // t are device (OpenHaptics) joint angles in rad, t3 the absolute forearm
 // angle; results are in the device frame.
 #ifndef VMHAPTICS_TESTS_SUPPORT_OPENHAPTICS_REFERENCE_H_
