@@ -148,6 +148,18 @@ class ClosedLoop {
   void on_control(const mjModel* m, mjData* d);
 
  private:
+  // construction, in order: the scene's <option>s (physics step,
+  // integrator); the servo period in physics steps, the run's length and
+  // the jitter; the controller (and the gimbal limits); the device chain
+  // SimDevice <- FaultInjector <- ReadingGuard; the start pose (sets
+  // R_start_base_, returns the joint angles)
+  void apply_model_options();
+  void setup_timing();
+  void setup_jitter(double h);
+  void build_controller();
+  void build_device_chain();
+  Joints start_pose();
+
   void set_hand_target(double t_s);
   // the next tick's physics steps (drawn when jittered)
   int draw_substeps();

@@ -175,25 +175,3 @@ TEST(ClosedLoopTest, NearestPointOnPathIsTheNearest) {
 
 }  // namespace
 }  // namespace vmh::sim
-
-namespace vmh::sim {
-namespace {
-
-// README.md's table of case parameters lists every field the loader knows
-// with its default, so the documented contract cannot drift from the code.
-TEST(CaseParameterDocs, ReadmeListsEveryField) {
-  std::ifstream in(std::string(VMH_MODELS_DIR) + "/../README.md");
-  ASSERT_TRUE(in.good());
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string readme = text.str();
-  for (const FieldSpec& f : case_fields()) {
-    const std::string row = std::string("| `") + f.name + "` | " +
-                            (f.default_value ? f.default_value : "(required)") +
-                            " | " + f.unit + " |";
-    EXPECT_NE(readme.find(row), std::string::npos) << "README.md lacks: " << row;
-  }
-}
-
-}  // namespace
-}  // namespace vmh::sim
