@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -501,6 +502,26 @@ TEST(CtlHelp, TopLevelHelpListsCtl) {
   const auto flag = c.out.find("--unilateral");
   ASSERT_NE(flag, std::string::npos);
   EXPECT_NE(c.out.find("the plane only pushes", flag), std::string::npos);
+}
+
+// `vmhaptics params` prints the parameter table; docs/parameters.md is that
+// output, verbatim, so it cannot drift from the code.
+TEST(Params, DocsFileIsWhatTheProgramPrints) {
+  const CliRun r = run("params");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  std::ifstream in(std::string(VMH_MODELS_DIR) + "/../docs/parameters.md");
+  ASSERT_TRUE(in.good());
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(r.out, text.str())
+      << "regenerate: build/vmhaptics params > docs/parameters.md";
+  for (const char* row : {"| `k_vel_ornt_Nmms_per_rad` | `--kv-ornt` |",
+                          "| `friction_mu` | `--mu` |",
+                          "| `unilateral` | `--unilateral` |",
+                          "| `duration_s` | - |"}) {
+    EXPECT_NE(r.out.find(row), std::string::npos) << row;
+  }
 }
 
 }  // namespace

@@ -13,7 +13,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <ostream>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -672,6 +674,24 @@ TEST(CaseParamTable, RowsAreUniqueAndBound) {
   const CaseParams c = load_case_params(
       "t", {{"vm_kind", "circle", ValueSource::kOverride, "test"}});
   EXPECT_EQ(c.values.size(), case_fields().size());
+}
+
+// docs/parameters.md is the program's table, verbatim (regenerate it with
+// `build/vmhaptics params > docs/parameters.md`).
+TEST(CaseParamTable, DocsAreTheGeneratedTable) {
+  std::ifstream in(std::string(VMH_MODELS_DIR) + "/../docs/parameters.md");
+  ASSERT_TRUE(in.good());
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str(), parameters_markdown())
+      << "docs/parameters.md is stale: run build/vmhaptics params > "
+         "docs/parameters.md";
+  // and it has a row for every parameter
+  for (const ParamSpec& f : case_fields()) {
+    EXPECT_NE(text.str().find(std::string("| `") + f.name + "` |"),
+              std::string::npos)
+        << f.name;
+  }
 }
 
 }  // namespace
