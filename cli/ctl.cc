@@ -19,13 +19,11 @@
 // table, --kv also set those to kv x 2 pi L).
 #include "cli/ctl.h"
 
-#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
-#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>

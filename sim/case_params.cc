@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -446,6 +445,14 @@ std::size_t row_of(const ParamSpec& spec) {
   return static_cast<std::size_t>(&spec - case_fields().data());
 }
 
+// A row the loader itself needs by name (a typo here is a bug, caught by
+// every load in the tests, not a user's mistake).
+const ParamSpec& row_named(const char* name) {
+  const ParamSpec* f = find_param(name);
+  if (f == nullptr) throw std::logic_error(std::string("no parameter ") + name);
+  return *f;
+}
+
 // "<where>: field '<name>'", the start of every message about a value
 std::string field_at(const ParamSpec& spec, const ParamValue& v) {
   return v.where + ": field '" + spec.name + "'";
@@ -636,7 +643,7 @@ CaseParams load_case_params(const std::string& source,
                        f.doc + ")");
     }
   }
-  const ParamValue& kind = c.values[row_of(*find_param("vm_kind"))];
+  const ParamValue& kind = c.values[row_of(row_named("vm_kind"))];
   const bool surface = kind.text == "surface";
   for (const ParamSpec& f : table) {
     ParamValue& v = c.values[row_of(f)];
@@ -651,7 +658,7 @@ CaseParams load_case_params(const std::string& source,
   for (const ParamSpec& f : table) f.bind(&c, c.values[row_of(f)]);
 
   const auto at = [&c](const char* name) {
-    const ParamSpec& f = *find_param(name);
+    const ParamSpec& f = row_named(name);
     return field_at(f, c.values[row_of(f)]);
   };
   if (c.sim.fault == SensorFaultKind::kJump && c.sim.fault_joint > 3) {
