@@ -9,15 +9,21 @@
 // A controller fault (vmh::is_fault, e.g. a NaN joint angle) still prints
 // the JSON, so that scripts can read the status, and then fails with exit
 // code 1 and one line on stderr.
+//
+// The controller's options (--vm, --kpos, --kv, --weights, ...) are not
+// defined here: each is a parameter of the case table (sim/case_params.h,
+// docs/parameters.md) with the same name, meaning, default and checks as the
+// scene's <custom> field, and both build ControllerParams with
+// sim::controller_params. --kv is K_v on the position rows only (as a
+// scene's k_vel_Ns_per_mm); --kv-ornt is the orientation rows' (until the
+// table, --kv also set those to kv x 2 pi L).
 #include "cli/ctl.h"
 
-#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
-#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -28,24 +34,18 @@
 #include "cli/json_util.h"
 #include "controller/controller.h"
 #include "controller/device_frame.h"
+#include "sim/case_params.h"
 
 namespace vmh::cli {
 
 namespace {
 
+// The controller's options are the table's (sim/case_params.h): one CLI
+// option per parameter with a ctl_option, its value as text, checked by the
+// same loader as a scene's. Only what is not a parameter is ctl's own.
 struct CtlOptions {
-  std::string vm = "circle";
-  std::string pivot_mm = "0,0,0";
-  std::string length_mm = "50";
-  std::string kpos = "0.5";
-  std::string kornt = "0";
-  std::string kv = "0";
-  std::string error = "thesis";
-  std::string placement = "gauss-newton";
-  std::string weights;  // empty: the default for the VM
-  std::string length_unit_mm = "1";
-  std::string mu = "0";
-  bool unilateral = false;
+  std::vector<std::string> values;    // per row of case_fields()
+  std::vector<CLI::Option*> options;  // per row; nullptr: no ctl option
   std::string ticks = "1";
   std::string q;
   std::string convention = "dh";
@@ -56,12 +56,6 @@ std::string trim(const std::string& s) {
   if (b == std::string::npos) return "";
   const auto e = s.find_last_not_of(" \t");
   return s.substr(b, e - b + 1);
-}
-
-std::string lower(std::string s) {
-  for (char& c : s)
-    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 std::vector<std::string> split(const std::string& text) {
@@ -114,27 +108,6 @@ Joints parse_joints(const std::string& option, const std::string& text) {
   return q;
 }
 
-Vec3 parse_vec3(const std::string& option, const std::string& text) {
-  const std::vector<double> v = parse_list(option, text, 3);
-  return Vec3(v[0], v[1], v[2]);
-}
-
-Vec6 parse_vec6(const std::string& option, const std::string& text) {
-  const std::vector<double> v = parse_list(option, text, 6);
-  Vec6 out;
-  for (int i = 0; i < 6; ++i) out[i] = v[static_cast<std::size_t>(i)];
-  return out;
-}
-
-// a finite number, or "inf" (never slides)
-double parse_mu(const std::string& text) {
-  const std::string t = lower(trim(text));
-  if (t == "inf" || t == "+inf" || t == "infinity" || t == "+infinity") {
-    return std::numeric_limits<double>::infinity();
-  }
-  return parse_number("--mu", text);
-}
-
 int parse_ticks(const std::string& text) {
   const double v = parse_number("--ticks", text);
   if (v < 1.0 || v > 1e6 || v != std::floor(v)) {
@@ -146,35 +119,11 @@ int parse_ticks(const std::string& text) {
   return static_cast<int>(v);
 }
 
-[[noreturn]] void unknown_value(const std::string& option,
-                                const std::string& value,
-                                const std::string& allowed) {
-  throw UsageError(option + ": unknown value '" + value +
-                   "' (expected one of: " + allowed + ")");
-}
-
-// The command-line option behind a ControllerParams field, for the message
-// of ControllerParams::validate ("controller parameter <field>: ...").
+// The option behind a ControllerParams::validate message ("controller
+// parameter <field>: ..."), "" if none.
 std::string option_for_field(const std::string& message) {
-  static const std::pair<const char*, const char*> kFields[] = {
-      {"vm.pivot_mm", "--pivot-mm"},
-      {"vm.length_mm", "--length-mm"},
-      {"vm.friction_mu", "--mu"},
-      {"gains.k_pos_N_per_mm", "--kpos"},
-      {"gains.k_ornt_Nmm_per_rad", "--kornt"},
-      {"gains.k_vel_Ns_per_mm", "--kv"},
-      {"gains.k_vel_ornt_Nmms_per_rad", "--kv"},
-      {"placement_options.weights", "--weights"},
-      {"length_unit_mm", "--length-unit-mm"},
-  };
-  const std::string prefix = "controller parameter ";
-  if (message.rfind(prefix, 0) != 0) return "";
-  const std::string field =
-      message.substr(prefix.size(), message.find(':') - prefix.size());
-  for (const auto& [name, option] : kFields) {
-    if (field == name) return option;
-  }
-  return "";
+  const sim::ParamSpec* p = sim::param_of_validate_message(message);
+  return p != nullptr && p->ctl_option != nullptr ? p->ctl_option : "";
 }
 
 // the controller's length unit as a name: "mm", "m", or "x<U>mm"
@@ -186,38 +135,23 @@ std::string unit_name(double unit_mm) {
   return buf;
 }
 
+// The controller's parameters from the options: the table's loader, then
+// the one function scenes use too (sim::controller_params).
 ControllerParams read_params(const CtlOptions& o) {
-  ControllerParams p;
-  if (!parse_vm_kind(o.vm.c_str(), &p.vm.kind)) {
-    unknown_value("--vm", o.vm, "circle, sphere, surface");
+  const std::vector<sim::ParamSpec>& table = sim::case_fields();
+  std::vector<std::pair<std::string, std::string>> given;
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    const CLI::Option* opt = o.options[i];
+    if (opt != nullptr && opt->count() > 0) {
+      given.emplace_back(table[i].ctl_option, o.values[i]);
+    }
   }
-  if (!parse_error_formulation(o.error.c_str(), &p.error)) {
-    unknown_value("--error", o.error, "thesis, geometric");
+  try {
+    return sim::controller_params(
+        sim::load_case_params("ctl", sim::ctl_inputs(given)));
+  } catch (const sim::ParamError& e) {
+    throw UsageError(e.what());
   }
-  if (!parse_placement_method(o.placement.c_str(), &p.placement)) {
-    unknown_value("--placement", o.placement, "gauss-newton, closed");
-  }
-  p.vm.pivot_mm = parse_vec3("--pivot-mm", o.pivot_mm);
-  p.vm.length_mm = parse_number("--length-mm", o.length_mm);
-  p.vm.friction_mu = parse_mu(o.mu);
-  p.vm.unilateral = o.unilateral;
-  const double L = p.vm.length_mm;
-  p.gains.k_pos_N_per_mm = parse_number("--kpos", o.kpos);
-  p.gains.k_ornt_Nmm_per_rad =
-      thesis_orientation_gain(parse_number("--kornt", o.kornt), L);
-  const double kv = parse_number("--kv", o.kv);
-  p.gains.k_vel_Ns_per_mm = kv;
-  // by analogy with eq. 3.28: the same multiple of the circumference
-  p.gains.k_vel_ornt_Nmms_per_rad = thesis_orientation_gain(kv, L);
-  if (o.weights.empty()) {
-    p.placement_options.weights = p.vm.kind == VmKind::kSurface
-                                      ? Vec6::Ones().eval()
-                                      : (Vec6() << 1, 1, 1, 0, 0, 0).finished();
-  } else {
-    p.placement_options.weights = parse_vec6("--weights", o.weights);
-  }
-  p.length_unit_mm = parse_number("--length-unit-mm", o.length_unit_mm);
-  return p;
 }
 
 Json angles_json(const VmAngles& theta) {
@@ -317,39 +251,26 @@ void register_ctl(CLI::App* app) {
                   "joint angles given as 'dh' (thesis Table B.1, q3 "
                   "relative) or 'device' (OpenHaptics, joint 3 absolute)")
       ->check(CLI::IsMember({"dh", "device"}));
-  cmd->add_option("--vm", o->vm,
-                  "virtual mechanism: circle (1 DOF), sphere (3) or surface "
-                  "(5); default circle");
-  cmd->add_option("--pivot-mm", o->pivot_mm,
-                  "pivot (circle, sphere) or a point of the plane (surface), "
-                  "x,y,z in the device frame (mm); default 0,0,0");
-  cmd->add_option("--length-mm", o->length_mm,
-                  "VM link length L (mm); default 50");
-  cmd->add_option("--kpos", o->kpos, "position gain K_pos (N/mm); default 0.5");
-  cmd->add_option("--kornt", o->kornt,
-                  "orientation gain as a multiple of the circumference "
-                  "(eq. 3.28): K_ornt = kornt * 2 pi L (N mm/rad); default 0");
-  cmd->add_option("--kv", o->kv,
-                  "velocity gain (N s/mm); the orientation rows get kv * 2 pi "
-                  "L (N mm s/rad); default 0");
-  cmd->add_option("--error", o->error,
-                  "error formulation: thesis (eq. 3.32-3.37) or geometric; "
-                  "default thesis");
-  cmd->add_option("--placement", o->placement,
-                  "VM placement: gauss-newton (eq. 3.15-3.16) or closed; "
-                  "default gauss-newton");
-  cmd->add_option("--weights", o->weights,
-                  "placement weights w1,...,w6 (x,y,z,theta_x,theta_y,"
-                  "theta_z); default 1,1,1,0,0,0 (circle, sphere) or "
-                  "1,1,1,1,1,1 (surface)");
-  cmd->add_option("--length-unit-mm", o->length_unit_mm,
-                  "the controller's length unit in mm: 1 = mm (thesis), "
-                  "1000 = m; default 1");
-  cmd->add_option("--mu", o->mu,
-                  "surface: Coulomb friction of the contact, >= 0 or inf; "
-                  "default 0 (slides freely)");
-  cmd->add_flag("--unilateral", o->unilateral,
-                "surface: the plane only pushes; the probe may lift off");
+  const std::vector<sim::ParamSpec>& table = sim::case_fields();
+  o->values.resize(table.size());
+  o->options.assign(table.size(), nullptr);
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    const sim::ParamSpec& f = table[i];
+    if (f.ctl_option == nullptr) continue;
+    std::string help = std::string(f.doc);
+    if (std::string(f.unit) != "-") help += " (" + std::string(f.unit) + ")";
+    if (f.size > 1) {
+      help += "; " + std::to_string(f.size) + " values, comma-separated";
+    }
+    help += "; default " +
+            std::string(f.ctl_default != nullptr ? f.ctl_default
+                                                 : f.default_text()) +
+            "; scene/--set: " + f.name;
+    // (add_flag's second argument would be taken as the flag's variable)
+    o->options[i] = f.ctl_flag
+                        ? cmd->add_flag(f.ctl_option)->description(help)
+                        : cmd->add_option(f.ctl_option, o->values[i], help);
+  }
   cmd->add_option("--ticks", o->ticks,
                   "ticks on the same q (warm start); the last is printed; "
                   "default 1");

@@ -2,7 +2,8 @@
 // object on stdout (or writes CSV files); errors are one line on stderr.
 //
 // Verbs: kin (kinematics of the Omni), ctl (one controller tick), run
-// (closed-loop simulation of the thesis cases), study (numerical studies).
+// (closed-loop simulation of the thesis cases), study (numerical studies),
+// params (the table of case parameters, docs/parameters.md).
 //
 // Exit codes: 0 success, 2 bad usage or bad input, 1 any other failure.
 #include <CLI/CLI.hpp>
@@ -12,6 +13,7 @@
 #include "cli/args.h"
 #include "cli/ctl.h"
 #include "cli/kin.h"
+#include "cli/params.h"
 #include "cli/run.h"
 #include "cli/study.h"
 
@@ -57,6 +59,7 @@ int main(int argc, char** argv) {
   vmh::cli::register_ctl(&app);
   vmh::cli::register_run(&app);
   vmh::cli::register_study(&app);
+  vmh::cli::register_params(&app);
 
   try {
     check_verbs(&app, argc, argv);

@@ -107,7 +107,7 @@ void run(const PrecisionCli& o) {
   try {
     sim::ClosedLoop probe(p.scene, p.overrides);
     period_s = probe.controller_params().servo_period_s;
-    script_s = probe.config().number("duration_s");
+    script_s = probe.config().sim.duration_s;
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study precision: ") + e.what());
   }

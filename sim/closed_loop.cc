@@ -44,15 +44,37 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
     : path_(scene_path),
       model_(load_model(scene_path)),
       config_(CaseConfig::from_model(model_.get(), scene_path, overrides)) {
+  apply_model_options();
+  setup_timing();
+  data_.reset(mj_makeData(model_.get()));
+  if (!data_) throw SimError(path_ + ": mj_makeData failed");
+  hand_ = std::make_unique<SimHand>(model_.get(), data_.get(),
+                                    hand_params(config_), path_);
+  build_controller();
+  build_device_chain();
+  qpos_before_.assign(static_cast<std::size_t>(model_->nq), 0.0);
+  dq_.assign(static_cast<std::size_t>(model_->nv), 0.0);
+  mv_.assign(static_cast<std::size_t>(model_->nv), 0.0);
+  script_ = std::make_unique<HandScript>(config_, params_.vm);
+  q_start_dh_ = start_pose();
+  reset();
+}
+
+void ClosedLoop::apply_model_options() {
   mjModel* m = model_.get();
-  const double h_set = config_.number("physics_step_s");
-  if (h_set > 0.0) m->opt.timestep = h_set;
-  const std::string& integrator = config_.text("integrator");
-  if (integrator == "euler") m->opt.integrator = mjINT_EULER;
-  if (integrator == "implicit") m->opt.integrator = mjINT_IMPLICIT;
-  if (integrator == "rk4") m->opt.integrator = mjINT_RK4;
-  const double T = config_.number("servo_period_s");
-  const double h = m->opt.timestep;
+  const SimSettings& sim = config_.sim;
+  if (sim.physics_step_s > 0.0) m->opt.timestep = sim.physics_step_s;
+  switch (sim.integrator) {
+    case IntegratorSetting::kScene: break;
+    case IntegratorSetting::kEuler: m->opt.integrator = mjINT_EULER; break;
+    case IntegratorSetting::kImplicit: m->opt.integrator = mjINT_IMPLICIT; break;
+    case IntegratorSetting::kRk4: m->opt.integrator = mjINT_RK4; break;
+  }
+}
+
+void ClosedLoop::setup_timing() {
+  const double T = config_.controller.servo_period_s;
+  const double h = model_->opt.timestep;
   const double n = std::round(T / h);
   if (n < 1.0 || std::abs(n * h - T) > 1e-9 * T) {
     throw SimError(path_ + ": servo_period_s (" + std::to_string(T) +
@@ -60,39 +82,41 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
                    std::to_string(h) + " s)");
   }
   substeps_ = static_cast<int>(n);
-  ticks_per_run_ =
-      static_cast<int>(std::llround(config_.number("duration_s") / T));
-  duration_s_ = config_.number("duration_s");
+  duration_s_ = config_.sim.duration_s;
+  ticks_per_run_ = static_cast<int>(std::llround(duration_s_ / T));
+  jitter_seed_ = config_.sim.jitter_seed;
+  setup_jitter(h);
+}
+
+void ClosedLoop::setup_jitter(double h) {
   jitter_lo_ = jitter_hi_ = substeps_;
-  const std::vector<double> jitter_s = config_.numbers("servo_jitter_s");
-  if (jitter_s[1] > 0.0) {
-    jitter_ = true;
-    jitter_lo_ = static_cast<int>(std::lround(jitter_s[0] / h));
-    jitter_hi_ = static_cast<int>(std::lround(jitter_s[1] / h));
-    if (jitter_lo_ < 1) {
-      throw SimError(path_ + ": servo_jitter_s's shortest period (" +
-                     std::to_string(jitter_s[0]) +
-                     " s) is less than one physics step (" + std::to_string(h) +
-                     " s)");
-    }
-    // the periods are drawn in whole physics steps: ends that are not whole
-    // steps would be moved without a word
-    for (double end_s : jitter_s) {
-      if (std::abs(std::round(end_s / h) * h - end_s) > 1e-9 * end_s) {
-        throw SimError(path_ + ": servo_jitter_s (" + std::to_string(end_s) +
-                       " s) must be a whole multiple of the physics step (" +
-                       std::to_string(h) + " s); set physics_step_s");
-      }
+  const double jitter_s[2] = {config_.sim.jitter_min_s,
+                              config_.sim.jitter_max_s};
+  if (!(jitter_s[1] > 0.0)) return;
+  jitter_ = true;
+  jitter_lo_ = static_cast<int>(std::lround(jitter_s[0] / h));
+  jitter_hi_ = static_cast<int>(std::lround(jitter_s[1] / h));
+  if (jitter_lo_ < 1) {
+    throw SimError(path_ + ": servo_jitter_s's shortest period (" +
+                   std::to_string(jitter_s[0]) +
+                   " s) is less than one physics step (" + std::to_string(h) +
+                   " s)");
+  }
+  // the periods are drawn in whole physics steps: ends that are not whole
+  // steps would be moved without a word
+  for (double end_s : jitter_s) {
+    if (std::abs(std::round(end_s / h) * h - end_s) > 1e-9 * end_s) {
+      throw SimError(path_ + ": servo_jitter_s (" + std::to_string(end_s) +
+                     " s) must be a whole multiple of the physics step (" +
+                     std::to_string(h) + " s); set physics_step_s");
     }
   }
-  jitter_seed_ = static_cast<std::uint64_t>(config_.number("jitter_seed"));
+}
 
-  data_.reset(mj_makeData(m));
-  if (!data_) throw SimError(path_ + ": mj_makeData failed");
-  hand_ = std::make_unique<SimHand>(m, data_.get(), hand_params(config_), path_);
-
+void ClosedLoop::build_controller() {
+  mjModel* m = model_.get();
   params_ = sim::controller_params(config_);
-  if (config_.number("gimbal_limits") == 0.0) {
+  if (!config_.sim.gimbal_limits) {
     // the wrist free to turn through its singularity: no limits on q4..q6 in
     // the model, and ranges that cover every angle for the controller's
     // check, the start pose's IK and the potentiometers' span
@@ -109,27 +133,29 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
   } catch (const std::invalid_argument& e) {
     throw SimError(path_ + ": " + e.what());
   }
-  device_ = std::make_unique<SimDevice>(
-      m, data_.get(), params_.omni, config_.number("quantize") != 0.0,
-      static_cast<int>(config_.number("delay_ticks")), path_);
+}
+
+void ClosedLoop::build_device_chain() {
+  const SimSettings& sim = config_.sim;
+  device_ = std::make_unique<SimDevice>(model_.get(), data_.get(),
+                                        params_.omni, sim.quantize,
+                                        sim.delay_ticks, path_);
   FaultSpec fault;
-  parse_sensor_fault_kind(config_.text("fault"), &fault.kind);
-  fault.joint = static_cast<int>(config_.number("fault_joint")) - 1;
-  fault.at_s = config_.number("fault_at_s");
+  fault.kind = sim.fault;
+  fault.joint = sim.fault_joint - 1;
+  fault.at_s = sim.fault_at_s;
   fault.jump_rad = kJumpCounts * 2.0 * kPi / params_.omni.encoder_counts_per_rev;
   injector_ = std::make_unique<FaultInjector>(device_.get(), fault);
   GuardParams guard;
-  guard.enabled = config_.number("sensor_guard") != 0.0;
-  guard.max_speed_rad_s = config_.number("guard_max_speed_rad_s");
-  guard.max_period_s = jitter_hi_ * h;
+  guard.enabled = sim.sensor_guard;
+  guard.max_speed_rad_s = sim.guard_max_speed_rad_s;
+  guard.max_period_s = jitter_hi_ * model_->opt.timestep;
   guard_ = std::make_unique<ReadingGuard>(injector_.get(), guard);
-  qpos_before_.assign(static_cast<std::size_t>(m->nq), 0.0);
-  dq_.assign(static_cast<std::size_t>(m->nv), 0.0);
-  mv_.assign(static_cast<std::size_t>(m->nv), 0.0);
-  script_ = std::make_unique<HandScript>(config_, params_.vm);
+}
 
-  // the start pose: the script's first target, the stylus turned the least
-  // from its home frame; the IK solution nearest the home pose
+Joints ClosedLoop::start_pose() {
+  // the script's first target, the stylus turned the least from its home
+  // frame; the IK solution nearest the home pose
   const OmniParams& omni = params_.omni;
   const ScriptPose start = script_->at(0.0);
   const Mat3 R_home = omni_fk(omni, Joints::Zero()).R_base;
@@ -154,8 +180,7 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
                    ") mm cannot be reached within the joint ranges; change "
                    "script_dir, vm_pivot_mm or vm_length_mm");
   }
-  q_start_dh_ = ik.q_dh[static_cast<std::size_t>(best)];
-  reset();
+  return ik.q_dh[static_cast<std::size_t>(best)];
 }
 
 ClosedLoop::~ClosedLoop() = default;

@@ -151,6 +151,18 @@ class ClosedLoop {
   Vec3 nearest_on_path_mm(const Vec3& p_mm) const;
 
  private:
+  // construction, in order: the scene's <option>s (physics step,
+  // integrator); the servo period in physics steps, the run's length and
+  // the jitter; the controller (and the gimbal limits); the device chain
+  // SimDevice <- FaultInjector <- ReadingGuard; the start pose (sets
+  // R_start_base_, returns the joint angles)
+  void apply_model_options();
+  void setup_timing();
+  void setup_jitter(double h);
+  void build_controller();
+  void build_device_chain();
+  Joints start_pose();
+
   // the next tick's physics steps (drawn when jittered)
   int draw_substeps();
 

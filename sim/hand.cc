@@ -84,14 +84,14 @@ void hand_control_callback(const mjModel* m, mjData* d) {
   if (hand != nullptr) hand->apply(m, d);
 }
 
-HandParams hand_params(const CaseConfig& c) {
+HandParams hand_params(const CaseParams& c) {
   HandParams h;
-  h.mass_kg = c.number("hand_mass_kg");
-  h.inertia_kgm2 = c.vec3("hand_inertia_kgm2");
-  h.k_pos_N_per_m = c.number("hand_k_pos_N_per_m");
-  h.b_pos_Ns_per_m = c.number("hand_b_pos_Ns_per_m");
-  h.k_rot_Nm_per_rad = c.number("hand_k_rot_Nm_per_rad");
-  h.b_rot_Nms_per_rad = c.number("hand_b_rot_Nms_per_rad");
+  h.mass_kg = c.hand.mass_kg;
+  h.inertia_kgm2 = c.hand.inertia_kgm2;
+  h.k_pos_N_per_m = c.hand.k_pos_N_per_m;
+  h.b_pos_Ns_per_m = c.hand.b_pos_Ns_per_m;
+  h.k_rot_Nm_per_rad = c.hand.k_rot_Nm_per_rad;
+  h.b_rot_Nms_per_rad = c.hand.b_rot_Nms_per_rad;
   return h;
 }
 

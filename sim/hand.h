@@ -42,7 +42,8 @@ struct HandParams {
   double b_rot_Nms_per_rad = 0.02;
 };
 
-HandParams hand_params(const CaseConfig& c);
+// The hand of a case (its hand_* parameters).
+HandParams hand_params(const CaseParams& c);
 
 // The target's pose and twist, world (DH base) frame, SI.
 struct HandTargetState {

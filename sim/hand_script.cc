@@ -22,17 +22,17 @@ double smoothstep(double s) {
 
 }  // namespace
 
-HandScript::HandScript(const CaseConfig& c, const VmParams& vm)
-    : name_(c.text("script")), kind_(vm.kind) {
+HandScript::HandScript(const CaseParams& c, const VmParams& vm)
+    : script_(c.script.kind), kind_(vm.kind) {
   pivot_ = vm.pivot_mm;
   n_ = vm.R_pivot.col(2);
   length_mm_ = vm.length_mm;
-  off_mm_ = c.number("script_off_mm");
-  misalign_rad_ = c.number("script_misalign_rad");
-  sweep_mm_ = c.number("script_sweep_mm");
-  sweep_rad_ = c.number("script_sweep_rad");
-  const Vec3 dir = c.vec3("script_dir").normalized();
-  const double D = c.number("duration_s");
+  off_mm_ = c.script.off_mm;
+  misalign_rad_ = c.script.misalign_rad;
+  sweep_mm_ = c.script.sweep_mm;
+  sweep_rad_ = c.script.sweep_rad;
+  const Vec3 dir = c.script.dir.normalized();
+  const double D = c.sim.duration_s;
 
   // the start pose: on the path, the stylus along `dir` (for the circle only
   // its projection on the plane counts, so it is aligned there too)
@@ -54,7 +54,7 @@ HandScript::HandScript(const CaseConfig& c, const VmParams& vm)
   axis0_ = kind_ == VmKind::kSurface ? n_ : dir;
   // an explicit stylus axis, for poses the direction alone cannot give (the
   // stylus along the forearm, or turned away from the link)
-  const Vec3 axis_set = c.vec3("script_axis");
+  const Vec3 axis_set = c.script.axis;
   if (axis_set.norm() > 1e-9) axis0_ = axis_set.normalized();
   p0_ = pivot_ + length_mm_ * r0_;
   // the tangent of the sweep: about the normal for circle and sphere
@@ -62,11 +62,11 @@ HandScript::HandScript(const CaseConfig& c, const VmParams& vm)
   if (t.norm() < 1e-6) t = r0_.unitOrthogonal();
   t0_ = t.normalized();
 
-  if (name_ == "hold") {
+  if (script_ == ScriptKind::kHold) {
     segments_ = {{"hold", 0.0, D, true}};
     return;
   }
-  if (name_ == "pivot") {
+  if (script_ == ScriptKind::kPivot) {
     // RM at the pivot, where theta_V is undefined (LL = 0 in §3.4.1), then
     // through it: two passes along r0 from one side of the path to the other
     segments_ = {{"at_pivot", 0.0, 0.4 * D, true},
@@ -74,7 +74,7 @@ HandScript::HandScript(const CaseConfig& c, const VmParams& vm)
     blend_s_ = std::min(0.3, 0.05 * D);
     return;
   }
-  if (name_ == "spin") {
+  if (script_ == ScriptKind::kSpin) {
     // the point held, the stylus swung about the VM's normal
     segments_ = {{"settle", 0.0, 0.1 * D, true}, {"spin", 0.1 * D, D, false}};
     blend_s_ = std::min(0.3, 0.025 * D);

@@ -39,10 +39,10 @@ struct ScriptSegment {
 
 class HandScript {
  public:
-  // Builds the script named by c.text("script") for the VM of `vm`
-  // (pivot, L, plane) over c.number("duration_s"). Throws SimError if the
-  // script does not apply to the VM.
-  HandScript(const CaseConfig& c, const VmParams& vm);
+  // Builds the script c.script for the VM of `vm` (pivot, L, plane) over
+  // c.sim.duration_s. Throws SimError, naming c's scene, if the script does
+  // not apply to the VM.
+  HandScript(const CaseParams& c, const VmParams& vm);
 
   ScriptPose at(double t_s) const;
   // index of the segment holding t (the last one past the end)
@@ -59,7 +59,7 @@ class HandScript {
  private:
   ScriptPose raw(int segment, double t_s) const;
 
-  std::string name_;
+  ScriptKind script_;
   std::vector<ScriptSegment> segments_;
   VmKind kind_;
   Vec3 pivot_, n_, r0_, t0_, p0_, axis0_;

@@ -214,7 +214,7 @@ ExtremeResult run_extreme(const ExtremeScenario& s,
   }
   const Vec3 shoulder_mm = base_to_device_mm(omni, Vec3::Zero());
   const double reach_mm = 1000.0 * (omni.l1_m + omni.l2_m);
-  const double script_end_s = loop.config().number("duration_s");
+  const double script_end_s = loop.config().sim.duration_s;
   const double end_s = script_end_s + kExtremeRestS;
 
   std::vector<TraceRow> local;
@@ -350,9 +350,9 @@ ExtremeResult run_extreme(const ExtremeScenario& s,
   // Colgate & Schenkel's bound for this scenario's translational gains
   const CaseConfig& c = loop.config();
   const double T_max_s = loop.substeps_max() * m->opt.timestep;
-  r.colgate_demand_Ns_per_m = 1000.0 * c.number("k_pos_N_per_mm") * T_max_s / 2.0 +
-                              1000.0 * std::abs(c.number("k_vel_Ns_per_mm"));
-  r.colgate_b_Ns_per_m = c.number("hand_b_pos_Ns_per_m");
+  r.colgate_demand_Ns_per_m = 1000.0 * c.controller.k_pos_N_per_mm * T_max_s / 2.0 +
+                              1000.0 * std::abs(c.controller.k_vel_Ns_per_mm);
+  r.colgate_b_Ns_per_m = c.hand.b_pos_Ns_per_m;
   r.colgate_passive = r.colgate_b_Ns_per_m > r.colgate_demand_Ns_per_m;
   r.energy_expected = s.energy;
   if (r.energy_expected == "bounded" && !r.colgate_passive) r.energy_expected = "either";

@@ -271,7 +271,7 @@ PrecisionResult run_precision_study(const PrecisionOptions& o) {
     for (const ScriptSegment& seg : probe.script().segments()) {
       if (seg.t0_s < o.duration_s) r.segments.push_back(seg);
     }
-    const double script_s = probe.config().number("duration_s");
+    const double script_s = probe.config().sim.duration_s;
     if (!(o.duration_s > 0.0) || o.duration_s > script_s + 1e-12) {
       throw SimError(o.scene + ": the study's duration (" +
                      exact(o.duration_s) + " s) must be > 0 and at most the "

@@ -140,7 +140,7 @@ CaseResult run_case(const std::string& name, const std::string& scene,
   result.scene = scene;
 
   ClosedLoop loop(scene, overrides);
-  const int thesis_case = static_cast<int>(loop.config().number("thesis_case"));
+  const int thesis_case = loop.config().thesis_case;
   if (auto ref = reference_params(thesis_case, loop.controller_params())) {
     loop.set_reference(*ref);
   }
@@ -168,16 +168,17 @@ CaseResult run_case(const std::string& name, const std::string& scene,
   nlohmann::json params = nlohmann::json::object();
   for (const FieldSpec& f : case_fields()) {
     nlohmann::json v;
+    const ParamValue& given = loop.config().value(f);
     if (f.is_text) {
-      v = loop.config().text(f.name);
+      v = given.text;
     } else if (f.size == 1) {
-      v = loop.config().number(f.name);
+      v = given.numbers[0];
     } else {
-      v = loop.config().numbers(f.name);
+      v = given.numbers;
     }
     params[f.name] = {{"value", v},
                       {"unit", f.unit},
-                      {"source", value_source_name(loop.config().source_of(f.name))}};
+                      {"source", value_source_name(given.source)}};
   }
   nlohmann::json warnings = nlohmann::json::object();
   int warning_total = 0;

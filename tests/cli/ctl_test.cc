@@ -4,7 +4,9 @@
 // the controller's own code.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -166,8 +168,44 @@ TEST(CtlJson, GainsFollowEq328) {
   EXPECT_DOUBLE_EQ(g["k_pos_N_per_mm"].get<double>(), 0.3);
   EXPECT_NEAR(g["k_ornt_Nmm_per_rad"].get<double>(), 0.5 * 2 * kPi * 40, 1e-12);
   EXPECT_DOUBLE_EQ(g["k_vel_Ns_per_mm"].get<double>(), 0.002);
-  EXPECT_NEAR(g["k_vel_ornt_Nmms_per_rad"].get<double>(), 0.002 * 2 * kPi * 40,
+  // --kv is the position rows' K_v only, as a scene's k_vel_Ns_per_mm (it
+  // used to set the orientation rows to kv x 2 pi L as well)
+  EXPECT_EQ(g["k_vel_ornt_Nmms_per_rad"].get<double>(), 0.0);
+}
+
+// The orientation rows' K_v is its own option, in N mm s/rad; the old --kv
+// behaviour is --kv-ornt = kv x 2 pi L.
+TEST(CtlJson, OrientationDampingIsItsOwnOption) {
+  const double kv = 0.002, L = 40.0;
+  std::ostringstream args;
+  args.precision(17);
+  args << "--length-mm " << L << " --kv " << kv << " --kv-ornt "
+       << kv * 2 * kPi * L << " --q 0.1,0.2,0.3,0.4,0.5,0.6";
+  const json j = ctl(args.str());
+  const json& g = j["gains"];
+  EXPECT_DOUBLE_EQ(g["k_vel_Ns_per_mm"].get<double>(), kv);
+  EXPECT_NEAR(g["k_vel_ornt_Nmms_per_rad"].get<double>(), kv * 2 * kPi * L,
               1e-15);
+  const json o = ctl("--kv-ornt 3 --q 0.1,0.2,0.3,0.4,0.5,0.6");
+  const json& only = o["gains"];
+  EXPECT_EQ(only["k_vel_Ns_per_mm"].get<double>(), 0.0);
+  EXPECT_EQ(only["k_vel_ornt_Nmms_per_rad"].get<double>(), 3.0);
+}
+
+// The controller settings ctl gained from the table change what it computes:
+// the force limit saturates, the servo period is accepted.
+TEST(CtlOptions, ForceLimitFromTheTable) {
+  const std::string q = " --q 0.1,0.2,0.3,0.4,0.5,0.6";
+  const json free = ctl("--kpos 2" + q);
+  const double f = vec3(free["force_device_N"]).norm();
+  ASSERT_GT(f, 0.2);
+  const json capped = ctl("--kpos 2 --force-limit-N 0.1" + q);
+  EXPECT_NEAR(vec3(capped["force_device_N"]).norm(), 0.1, 1e-12);
+  EXPECT_NE(std::find(capped["status"].begin(), capped["status"].end(),
+                      "force_saturated"),
+            capped["status"].end());
+  EXPECT_NO_THROW(ctl("--servo-period-s 0.002 --projection-weights "
+                      "1,1,1,2,2,2" + q));
 }
 
 TEST(CtlCircle, CaseOneForceIsKposTimesTheErrorToTheNearestPoint) {
@@ -401,7 +439,8 @@ TEST(CtlErrors, BadInputIsAUsageErrorNamingTheOption) {
   expect_usage_error("ctl --q 0,0,x,0,0,0", "item 3 'x' is not a number");
   expect_usage_error("ctl", "--q");
   expect_usage_error("ctl --length-mm 0" + q, "--length-mm");
-  expect_usage_error("ctl --length-mm=-5" + q, "vm.length_mm");
+  expect_usage_error("ctl --length-mm=-5" + q,
+                     "--length-mm: field 'vm_length_mm' must be > 0");
   expect_usage_error("ctl --error foo" + q,
                      "--error: unknown value 'foo' (expected one of: thesis, "
                      "geometric)");
@@ -412,7 +451,14 @@ TEST(CtlErrors, BadInputIsAUsageErrorNamingTheOption) {
   expect_usage_error("ctl --kv abc" + q, "--kv");
   expect_usage_error("ctl --vm surface --mu=-0.5" + q, "--mu");
   expect_usage_error("ctl --weights 0,0,0,0,0,0" + q, "--weights");
-  expect_usage_error("ctl --weights 1,1,1" + q, "--weights: expected 6");
+  expect_usage_error("ctl --weights 1,1,1" + q,
+                     "--weights: field 'placement_weights' expects 6");
+  expect_usage_error("ctl --kv-ornt=-1" + q, "--kv-ornt");
+  expect_usage_error("ctl --vm surface --mu=-inf" + q, "--mu");
+  expect_usage_error("ctl --kpos inf" + q, "not finite");
+  expect_usage_error("ctl --projection-weights 1,1,1,1,1,0" + q,
+                     "--projection-weights");
+  expect_usage_error("ctl --force-limit-N 0" + q, "--force-limit-N");
   expect_usage_error("ctl --length-unit-mm 0" + q, "--length-unit-mm");
   expect_usage_error("ctl --pivot-mm 1,2" + q, "--pivot-mm");
   expect_usage_error("ctl --ticks 0" + q, "--ticks");
@@ -449,6 +495,33 @@ TEST(CtlHelp, TopLevelHelpListsCtl) {
   const CliRun c = run("ctl --help");
   EXPECT_EQ(c.exit_code, 0);
   EXPECT_NE(c.out.find("--kornt"), std::string::npos);
+  EXPECT_NE(c.out.find("--kv-ornt"), std::string::npos);
+  // each option names the scene's parameter it is
+  EXPECT_NE(c.out.find("k_vel_ornt_Nmms_per_rad"), std::string::npos);
+  // the flag is described too
+  const auto flag = c.out.find("--unilateral");
+  ASSERT_NE(flag, std::string::npos);
+  EXPECT_NE(c.out.find("the plane only pushes", flag), std::string::npos);
+}
+
+// `vmhaptics params` prints the parameter table; docs/parameters.md is that
+// output, verbatim, so it cannot drift from the code.
+TEST(Params, DocsFileIsWhatTheProgramPrints) {
+  const CliRun r = run("params");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  std::ifstream in(std::string(VMH_MODELS_DIR) + "/../docs/parameters.md");
+  ASSERT_TRUE(in.good());
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(r.out, text.str())
+      << "regenerate: build/vmhaptics params > docs/parameters.md";
+  for (const char* row : {"| `k_vel_ornt_Nmms_per_rad` | `--kv-ornt` |",
+                          "| `friction_mu` | `--mu` |",
+                          "| `unilateral` | `--unilateral` |",
+                          "| `duration_s` | - |"}) {
+    EXPECT_NE(r.out.find(row), std::string::npos) << row;
+  }
 }
 
 }  // namespace

@@ -180,22 +180,6 @@ TEST(ClosedLoopTest, NearestPointOnPathIsTheNearest) {
 namespace vmh::sim {
 namespace {
 
-// docs/cli.md's table of case parameters lists every field the loader knows
-// with its default, so the documented contract cannot drift from the code.
-TEST(CaseParameterDocs, ReadmeListsEveryField) {
-  std::ifstream in(std::string(VMH_MODELS_DIR) + "/../docs/cli.md");
-  ASSERT_TRUE(in.good());
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string readme = text.str();
-  for (const FieldSpec& f : case_fields()) {
-    const std::string row = std::string("| `") + f.name + "` | " +
-                            (f.default_value ? f.default_value : "(required)") +
-                            " | " + f.unit + " |";
-    EXPECT_NE(readme.find(row), std::string::npos) << "docs/cli.md lacks: " << row;
-  }
-}
-
 // The hand's physics does not depend on who steps: case 2 driven by
 // ClosedLoop::tick, and the same scene stepped by plain mj_step with the
 // same hand targets and the same held motor commands, follow the same

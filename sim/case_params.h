@@ -1,0 +1,220 @@
+// A case's parameters as typed members, and the one table they come from.
+//
+// Every parameter is defined once, in case_fields(): its name (the scene's
+// <custom> name and the `--set name=` name), type and size, default, unit,
+// valid range, meaning, `vmhaptics ctl` option (if any) and a binding to its
+// typed member of CaseParams. The loader, the validation, ctl's options and
+// docs/parameters.md (`vmhaptics params`) are all made from that table.
+//
+// Values arrive as text, each with where it came from (a scene file, `--set`
+// or a ctl option), are checked once here, and are then read as typed
+// members: nobody looks a parameter up by its name after loading.
+//
+// This header and its source need no MuJoCo: `ctl` uses them without a
+// scene. The reading of a scene's <custom> fields is in sim/case_config.h.
+#ifndef VMHAPTICS_SIM_CASE_PARAMS_H_
+#define VMHAPTICS_SIM_CASE_PARAMS_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "controller/controller.h"
+#include "controller/types.h"
+#include "sim/fault_injector.h"
+
+namespace vmh::sim {
+
+// A bad parameter: the message names where it came from (file, `--set` or
+// a ctl option) and the field.
+struct ParamError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Where a value came from.
+enum class ValueSource { kDefault, kScene, kOverride };
+const char* value_source_name(ValueSource s);  // default, scene, set
+
+enum class IntegratorSetting { kScene, kEuler, kImplicit, kRk4 };
+enum class ScriptKind { kThesis, kHold, kPivot, kSpin };
+
+// The controller's settings, shared by scenes and `ctl`. Device frame, mm.
+// No defaults here: the loader fills every member from the table.
+struct ControllerSettings {
+  VmKind vm_kind{};
+  Vec3 vm_pivot_mm = Vec3::Zero();
+  double vm_length_mm{};
+  double friction_mu{};  // surface only; +inf: never slides
+  bool unilateral{};     // surface only
+  double k_pos_N_per_mm{};
+  double k_ornt_multiple{};  // K_ornt = multiple x 2 pi L (eq. 3.28)
+  double k_vel_Ns_per_mm{};          // K_v, position rows
+  double k_vel_ornt_Nmms_per_rad{};  // K_v, orientation rows
+  Vec6 placement_weights = Vec6::Zero();
+  Vec6 projection_weights = Vec6::Zero();
+  double length_unit_mm{};
+  ErrorFormulation error{};
+  PlacementMethod placement{};
+  double servo_period_s{};
+  double force_limit_N{};
+};
+
+// The simulator's settings around the controller.
+struct SimSettings {
+  double physics_step_s{};  // 0: keep the scene's
+  IntegratorSetting integrator{};  // kScene: keep the scene's
+  int delay_ticks{};
+  bool quantize{};
+  double jitter_min_s{}, jitter_max_s{};  // both 0: no jitter
+  std::uint64_t jitter_seed{};
+  SensorFaultKind fault{};
+  int fault_joint{};  // 1..6
+  double fault_at_s{};
+  bool sensor_guard{};
+  double guard_max_speed_rad_s{};
+  bool gimbal_limits{};
+  double duration_s{};
+};
+
+// The simulated hand's impedance (models/hand/README.md).
+struct HandSettings {
+  double mass_kg{};
+  Vec3 inertia_kgm2 = Vec3::Zero();
+  double k_pos_N_per_m{};
+  double b_pos_Ns_per_m{};
+  double k_rot_Nm_per_rad{};
+  double b_rot_Nms_per_rad{};
+};
+
+// The hand script (sim/hand_script.h). Device frame.
+struct ScriptSettings {
+  ScriptKind kind{};
+  std::string name;  // thesis, hold, pivot or spin
+  Vec3 dir = Vec3::Zero();
+  Vec3 axis = Vec3::Zero();  // 0 0 0: along dir
+  double off_mm{};
+  double misalign_rad{};
+  double sweep_mm{};
+  double sweep_rad{};
+};
+
+// One parameter's value as given, and where from (summary.json reports it).
+struct ParamValue {
+  std::string text;             // text parameters
+  std::vector<double> numbers;  // numeric parameters
+  ValueSource source = ValueSource::kDefault;
+  std::string where;  // the file, "--set" or the ctl option, for messages
+  bool set = false;
+};
+
+struct ParamSpec;
+
+struct CaseParams {
+  int thesis_case{};
+  ControllerSettings controller;
+  SimSettings sim;
+  HandSettings hand;
+  ScriptSettings script;
+
+  // the scene file (or "ctl")
+  const std::string& scene_path() const { return source; }
+  // the value of one table row, as given (summary.json); `spec` must be an
+  // element of case_fields()
+  const ParamValue& value(const ParamSpec& spec) const;
+
+  std::string source;
+  std::vector<ParamValue> values;  // one per row of case_fields()
+};
+
+// The check on a numeric parameter, item by item.
+enum class ParamRule {
+  kAny,
+  kPositive,     // > 0
+  kNonNegative,  // >= 0
+  kWhole,        // whole number in [lo, hi]
+};
+
+// One row of the table.
+struct ParamSpec {
+  const char* name;
+  bool is_text;
+  int size;                   // number of values (numeric parameters)
+  const char* default_value;  // nullptr: required
+  const char* unit;
+  const char* doc;
+  const char* group;  // controller, sim, hand, script, case
+  ParamRule rule = ParamRule::kAny;
+  double lo = 0.0, hi = 0.0;   // kWhole
+  bool allow_inf = false;      // +inf is a valid value
+  const char* words = nullptr; // text: the valid values, ", "-separated
+  const char* range_note = nullptr;  // a rule beyond `rule`, for the docs
+  // the default when vm_kind is surface, if different
+  const char* surface_default = nullptr;
+  // `vmhaptics ctl`: the option (nullptr: none), its default if the
+  // parameter has none, whether it is a flag (0 or 1 without a value)
+  const char* ctl_option = nullptr;
+  const char* ctl_default = nullptr;
+  bool ctl_flag = false;
+  void (*bind)(CaseParams*, const ParamValue&) = nullptr;
+
+  // the range as text: "> 0", "0 .. 64, whole", "circle, sphere, surface"
+  std::string range_text() const;
+  // the default as text, with the surface's and ctl's where they differ
+  std::string default_text() const;
+};
+using FieldSpec = ParamSpec;  // the older name
+
+// The table of every known parameter.
+const std::vector<ParamSpec>& case_fields();
+// nullptr when no parameter has that name
+const ParamSpec* find_param(const std::string& name);
+// all names, ", "-separated, for messages
+std::string param_names();
+
+// One value as text, with where it came from. `where` names the file,
+// "--set" or the ctl option in messages.
+struct ParamInput {
+  std::string name;
+  std::string value;
+  ValueSource source = ValueSource::kOverride;
+  std::string where;
+};
+
+// "name=value" items of `--set` (vectors comma- or space-separated) as
+// inputs; throws ParamError on a missing '=' or an unknown name.
+std::vector<ParamInput> set_inputs(const std::vector<std::string>& sets);
+
+// The inputs of `vmhaptics ctl`'s options: (option, value) pairs as given
+// on the command line (a flag's value is ignored: giving it means 1), then
+// the ctl defaults (ParamSpec::ctl_default) of those not given. Throws
+// ParamError on an option the table does not have.
+std::vector<ParamInput> ctl_inputs(
+    const std::vector<std::pair<std::string, std::string>>& given);
+
+// Reads `inputs` in order (a later one replaces an earlier one of the same
+// name), fills what none gives with the defaults, checks every value and
+// returns the typed parameters. `source` names the case in messages about a
+// missing parameter. Throws ParamError naming where and the field.
+CaseParams load_case_params(const std::string& source,
+                            const std::vector<ParamInput>& inputs);
+
+// The controller's parameters: the one route from settings to
+// ControllerParams for scenes and `ctl`.
+ControllerParams controller_params(const ControllerSettings& s);
+inline ControllerParams controller_params(const CaseParams& c) {
+  return controller_params(c.controller);
+}
+
+// The parameter behind a ControllerParams::validate message ("controller
+// parameter <field>: ..."); nullptr if none.
+const ParamSpec* param_of_validate_message(const std::string& message);
+
+// The table as Markdown (docs/parameters.md is this, verbatim).
+std::string parameters_markdown();
+
+}  // namespace vmh::sim
+
+#endif  // VMHAPTICS_SIM_CASE_PARAMS_H_
