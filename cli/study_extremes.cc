@@ -37,11 +37,11 @@ std::string joined(const std::vector<std::string>& v) {
   return s.empty() ? "-" : s;
 }
 
-void print_table(const std::vector<sim::ExtremeResult>& results) {
+void print_table(const std::vector<studies::ExtremeResult>& results) {
   std::printf("%-24s %-34s %7s %8s %9s %9s %7s  %s\n", "scenario", "outcome",
               "maxF_N", "Emax_mJ", "Efinal_mJ", "rest_mJ", "wall_s",
               "statuses");
-  for (const sim::ExtremeResult& r : results) {
+  for (const studies::ExtremeResult& r : results) {
     std::vector<std::string> named = r.statuses;
     named.insert(named.end(), r.device_errors.begin(), r.device_errors.end());
     named.insert(named.end(), r.guard_faults.begin(), r.guard_faults.end());
@@ -54,11 +54,11 @@ void print_table(const std::vector<sim::ExtremeResult>& results) {
 }
 
 void run(const ExtremesOptions& o) {
-  std::vector<sim::ExtremeResult> results;
+  std::vector<studies::ExtremeResult> results;
   nlohmann::json j;
   try {
-    j = sim::run_extremes_study(o.only, o.out,
-                                o.jobs > 0 ? o.jobs : sim::core_count(), &results);
+    j = studies::run_extremes_study(o.only, o.out,
+                                o.jobs > 0 ? o.jobs : report::core_count(), &results);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study extremes: ") + e.what());
   }
@@ -69,7 +69,7 @@ void run(const ExtremesOptions& o) {
   }
   std::cout.flush();
   std::string failed;
-  for (const sim::ExtremeResult& r : results) {
+  for (const studies::ExtremeResult& r : results) {
     if (!r.pass()) failed += " " + r.scenario.name + "(" + r.outcome + ")";
   }
   if (!failed.empty()) {

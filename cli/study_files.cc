@@ -19,7 +19,7 @@ std::string study_scene(const std::string& option, const std::string& value,
     target = "case" + value;
   }
   try {
-    return sim::resolve_scene(target, name);
+    return studies::resolve_scene(target, name);
   } catch (const sim::SimError& e) {
     throw UsageError(option + ": " + e.what());
   }
@@ -47,7 +47,7 @@ std::string write_study_file(const std::string& dir, const std::string& name,
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error(dir + ": " + ec.message());
   const fs::path path = fs::path(dir) / name;
-  sim::write_file_atomically(path.string(), text);
+  report::write_file_atomically(path.string(), text);
   return path.string();
 }
 

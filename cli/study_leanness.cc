@@ -23,18 +23,18 @@ namespace {
 
 struct LeannessCli {
   std::vector<std::string> cases;  // empty: the six
-  double duration_s = sim::LeannessOptions{}.duration_s;
-  int repeats = sim::LeannessOptions{}.repeats;
+  double duration_s = studies::LeannessOptions{}.duration_s;
+  int repeats = studies::LeannessOptions{}.repeats;
   std::vector<std::string> sets;
   std::string out;
 };
 
 Json ingredient_names(unsigned ingredients) {
   Json names = Json::array();
-  if (ingredients & sim::kContacts) names.push_back("contacts");
-  if (ingredients & sim::kGravity) names.push_back("gravity");
-  if (ingredients & sim::kRendering) names.push_back("rendering");
-  if (ingredients & sim::kNoFrictionloss) names.push_back("no_frictionloss");
+  if (ingredients & studies::kContacts) names.push_back("contacts");
+  if (ingredients & studies::kGravity) names.push_back("gravity");
+  if (ingredients & studies::kRendering) names.push_back("rendering");
+  if (ingredients & studies::kNoFrictionloss) names.push_back("no_frictionloss");
   return names;
 }
 
@@ -46,9 +46,9 @@ double median(std::vector<double> v) {
 }
 
 void run(const LeannessCli& o) {
-  sim::LeannessOptions p;
+  studies::LeannessOptions p;
   if (o.cases.empty()) {
-    for (const sim::CaseEntry& c : sim::thesis_cases()) {
+    for (const studies::CaseEntry& c : studies::thesis_cases()) {
       std::string name;
       const std::string scene = study_scene("--case", c.name, &name);
       p.scenes.emplace_back(name, scene);
@@ -78,19 +78,19 @@ void run(const LeannessCli& o) {
   }
   p.overrides = o.sets;
 
-  sim::LeannessResult r;
+  studies::LeannessResult r;
   try {
-    r = sim::run_leanness_study(p);
+    r = studies::run_leanness_study(p);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study leanness: ") + e.what());
   }
 
   Json cases = Json::array();
-  std::vector<std::vector<double>> slowdowns(sim::leanness_variants().size());
-  for (const sim::CaseLeanness& c : r.cases) {
+  std::vector<std::vector<double>> slowdowns(studies::leanness_variants().size());
+  for (const studies::CaseLeanness& c : r.cases) {
     Json variants = Json::array();
     for (std::size_t i = 0; i < c.variants.size(); ++i) {
-      const sim::VariantResult& v = c.variants[i];
+      const studies::VariantResult& v = c.variants[i];
       slowdowns[i].push_back(v.cpu_slowdown);
       variants.push_back({
           {"variant", v.variant.name},
@@ -128,8 +128,8 @@ void run(const LeannessCli& o) {
                      {"variants", variants}});
   }
   Json summary = Json::object();
-  for (std::size_t i = 0; i < sim::leanness_variants().size(); ++i) {
-    summary[sim::leanness_variants()[i].name] = {
+  for (std::size_t i = 0; i < studies::leanness_variants().size(); ++i) {
+    summary[studies::leanness_variants()[i].name] = {
         {"median_cpu_slowdown", median(slowdowns[i])}};
   }
 
@@ -149,7 +149,7 @@ void run(const LeannessCli& o) {
   };
   if (!o.out.empty()) {
     result["files"] = Json::array(
-        {write_study_file(o.out, "leanness.csv", sim::leanness_csv(r))});
+        {write_study_file(o.out, "leanness.csv", studies::leanness_csv(r))});
   }
   std::cout << dump_readable(result) << '\n';
 }

@@ -26,11 +26,11 @@ namespace {
 
 struct PrecisionCli {
   std::string case_name = "1";
-  double duration_s = sim::PrecisionOptions{}.duration_s;
+  double duration_s = studies::PrecisionOptions{}.duration_s;
   std::string steps;        // empty: the default ladder
   std::string integrators;  // empty: all three
-  double reference_step_s = sim::PrecisionOptions{}.reference_step_s;
-  double reference_check_step_s = sim::PrecisionOptions{}.reference_check_step_s;
+  double reference_step_s = studies::PrecisionOptions{}.reference_step_s;
+  double reference_check_step_s = studies::PrecisionOptions{}.reference_check_step_s;
   std::vector<std::string> sets;
   std::string out;
 };
@@ -50,7 +50,7 @@ bool divides(double step_s, double period_s) {
 // NaN (a run that blew up) as JSON null
 Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(); }
 
-Json error_json(const sim::TrajectoryError& e) {
+Json error_json(const studies::TrajectoryError& e) {
   return {{"rms_error_mm", number_or_null(e.rms_mm)},
           {"max_error_mm", number_or_null(e.max_mm)},
           {"rms_axis_error_rad", number_or_null(e.rms_axis_rad)},
@@ -62,7 +62,7 @@ Json error_json(const sim::TrajectoryError& e) {
 }
 
 void run(const PrecisionCli& o) {
-  sim::PrecisionOptions p;
+  studies::PrecisionOptions p;
   std::string name;
   p.scene = study_scene("--case", o.case_name, &name);
   if (!(o.duration_s > 0.0)) {
@@ -81,8 +81,8 @@ void run(const PrecisionCli& o) {
     while (true) {
       const auto comma = o.integrators.find(',', start);
       const std::string item = o.integrators.substr(start, comma - start);
-      sim::Integrator i;
-      if (!sim::parse_integrator(item, &i)) {
+      studies::Integrator i;
+      if (!studies::parse_integrator(item, &i)) {
         throw UsageError("--integrators: unknown integrator '" + item +
                          "' (euler, implicit or rk4)");
       }
@@ -138,16 +138,16 @@ void run(const PrecisionCli& o) {
                      " s, got " + g(o.reference_check_step_s));
   }
 
-  sim::PrecisionResult r;
+  studies::PrecisionResult r;
   try {
-    r = sim::run_precision_study(p);
+    r = studies::run_precision_study(p);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study precision: ") + e.what());
   }
 
   Json rows = Json::array();
-  for (const sim::PrecisionRow& row : r.rows) {
-    Json j = {{"integrator", sim::integrator_name(row.integrator)},
+  for (const studies::PrecisionRow& row : r.rows) {
+    Json j = {{"integrator", studies::integrator_name(row.integrator)},
               {"h_s", row.step_s},
               {"substeps_per_tick", row.substeps}};
     j.update(error_json(row.error));
@@ -165,17 +165,17 @@ void run(const PrecisionCli& o) {
     rows.push_back(j);
   }
   Json orders = Json::array();
-  for (const sim::OrderFit& f : r.fits) {
-    orders.push_back({{"integrator", sim::integrator_name(f.integrator)},
+  for (const studies::OrderFit& f : r.fits) {
+    orders.push_back({{"integrator", studies::integrator_name(f.integrator)},
                       {"order", number_or_null(f.order)},
                       {"log10_coefficient", number_or_null(f.log10_coefficient)},
                       {"points", f.points},
                       {"h_used_s", f.steps_used_s}});
   }
   Json def = Json::object();
-  for (const sim::PrecisionRow& row : r.rows) {
+  for (const studies::PrecisionRow& row : r.rows) {
     if (!row.is_default) continue;
-    def = {{"integrator", sim::integrator_name(row.integrator)},
+    def = {{"integrator", studies::integrator_name(row.integrator)},
            {"h_s", row.step_s},
            {"rms_error_mm", number_or_null(row.error.rms_mm)},
            {"max_error_mm", number_or_null(row.error.max_mm)},
@@ -185,11 +185,11 @@ void run(const PrecisionCli& o) {
            {"on_front_cpu", row.on_front_cpu}};
     // the settings that beat it on both error and time
     Json better = Json::array();
-    for (const sim::PrecisionRow& other : r.rows) {
+    for (const studies::PrecisionRow& other : r.rows) {
       if (other.error.finite && row.error.finite &&
           other.error.rms_mm < row.error.rms_mm &&
           other.wall_time_s < row.wall_time_s) {
-        better.push_back({{"integrator", sim::integrator_name(other.integrator)},
+        better.push_back({{"integrator", studies::integrator_name(other.integrator)},
                           {"h_s", other.step_s}});
       }
     }
@@ -197,15 +197,15 @@ void run(const PrecisionCli& o) {
   }
   if (def.empty()) {
     // the default integrator was left out with --integrators
-    def = {{"integrator", sim::integrator_name(r.default_integrator)},
+    def = {{"integrator", studies::integrator_name(r.default_integrator)},
            {"h_s", r.default_step_s},
            {"on_front", nullptr},
            {"on_front_cpu", nullptr}};
   }
   Json front = Json::array();
-  for (const sim::PrecisionRow& row : r.rows) {
+  for (const studies::PrecisionRow& row : r.rows) {
     if (row.on_front) {
-      front.push_back({{"integrator", sim::integrator_name(row.integrator)},
+      front.push_back({{"integrator", studies::integrator_name(row.integrator)},
                        {"h_s", row.step_s}});
     }
   }
@@ -242,12 +242,12 @@ void run(const PrecisionCli& o) {
   };
   if (!o.out.empty()) {
     Json files = Json::array();
-    files.push_back(write_study_file(o.out, "precision.csv", sim::precision_csv(r)));
+    files.push_back(write_study_file(o.out, "precision.csv", studies::precision_csv(r)));
     files.push_back(write_study_file(o.out, "precision.svg",
-                                     sim::chart_svg(sim::precision_chart(r))));
+                                     report::chart_svg(studies::precision_chart(r))));
     files.push_back(write_study_file(
         o.out, "precision_order.svg",
-        sim::chart_svg(sim::precision_order_chart(r))));
+        report::chart_svg(studies::precision_order_chart(r))));
     result["files"] = files;
   }
   std::cout << dump_readable(result) << '\n';

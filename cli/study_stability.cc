@@ -68,7 +68,7 @@ constexpr int kDefaultStepsPerTick = 1000;
 constexpr double kDefaultMapBMaxTimesMOverT = 0.1;
 
 void write_file(const fs::path& path, const std::string& text) {
-  sim::write_file_atomically(path.string(), text);
+  report::write_file_atomically(path.string(), text);
 }
 
 void make_out_dir(const std::string& out) {
@@ -81,8 +81,8 @@ void make_out_dir(const std::string& out) {
 
 // The parameters, checked. For --map, B is the sweep's and is checked per
 // point; here it stands at 1 N s/m so that b = 0 passes.
-sim::StabilityParams params_from(const StabilityOptions& o) {
-  sim::StabilityParams p;
+studies::StabilityParams params_from(const StabilityOptions& o) {
+  studies::StabilityParams p;
   p.mass_kg = o.mass_kg;
   p.damping_Ns_per_m = o.damping_Ns_per_m;
   p.servo_period_s = o.servo_period_s;
@@ -93,7 +93,7 @@ sim::StabilityParams params_from(const StabilityOptions& o) {
     p.physics_step_s = o.servo_period_s / kDefaultStepsPerTick;
   }
   try {
-    sim::validate(p);
+    studies::validate(p);
   } catch (const sim::SimError& e) {
     throw UsageError(e.what());
   }
@@ -111,7 +111,7 @@ double rel(double value, double reference) {
   return reference != 0.0 ? value / reference - 1.0 : std::nan("");
 }
 
-Json inputs_json(const sim::StabilityParams& p, bool with_controller) {
+Json inputs_json(const studies::StabilityParams& p, bool with_controller) {
   Json j = Json::object();
   j["mass_kg"] = p.mass_kg;
   j["damping_Ns_per_m"] = p.damping_Ns_per_m;
@@ -122,16 +122,16 @@ Json inputs_json(const sim::StabilityParams& p, bool with_controller) {
     j["delay_s"] = p.delay_ticks * p.servo_period_s;
   }
   j["physics_step_s"] = p.physics_step_s;
-  j["steps_per_tick"] = sim::steps_per_tick(p);
+  j["steps_per_tick"] = studies::steps_per_tick(p);
   j["velocity_estimate"] = "backward difference (x_k - x_{k-1})/T";
-  j["initial_displacement_m"] = sim::kInitialDisplacement_m;
+  j["initial_displacement_m"] = studies::kInitialDisplacement_m;
   return j;
 }
 
 // the bisection's runs: growth rate against K, the theories' K as vertical
 // lines
-std::string bisection_svg(const sim::StabilityReport& r) {
-  sim::Chart c;
+std::string bisection_svg(const studies::StabilityReport& r) {
+  report::Chart c;
   char title[200];
   std::snprintf(title, sizeof title,
                 "Bisection on K: m = %g kg, b = %g N s/m, T = %g ms, B = %g "
@@ -143,11 +143,11 @@ std::string bisection_svg(const sim::StabilityReport& r) {
   c.x.label = "stiffness K (N/m)";
   c.y.label = "envelope growth rate (1/s)";
   c.width_px = 820;
-  sim::ChartSeries runs;
+  report::ChartSeries runs;
   runs.label = "simulated runs";
   runs.line = false;
   double lo = 0.0, hi = 0.0;
-  for (const sim::WallRun& w : r.sim.history) {
+  for (const studies::WallRun& w : r.sim.history) {
     if (w.diverged) continue;  // off the scale
     runs.x.push_back(w.k_N_per_m);
     runs.y.push_back(w.growth_rate_per_s);
@@ -157,7 +157,7 @@ std::string bisection_svg(const sim::StabilityReport& r) {
   c.series.push_back(runs);
   auto vertical = [&](const std::string& label, double k, const char* color,
                       bool dashed) {
-    sim::ChartSeries s;
+    report::ChartSeries s;
     s.label = label;
     s.x = {k, k};
     s.y = {lo, hi};
@@ -170,16 +170,16 @@ std::string bisection_svg(const sim::StabilityReport& r) {
   vertical("exact discrete", r.exact.k_crit_N_per_m, "#2ca02c", true);
   vertical("Gil et al. (b+B)/(T/2+nT)", r.k_bound_gil_N_per_m, "#d62728",
            true);
-  return sim::chart_svg(c);
+  return report::chart_svg(c);
 }
 
-std::string bisection_csv(const sim::StabilityReport& r) {
+std::string bisection_csv(const studies::StabilityReport& r) {
   std::string s =
       "run,k_N_per_m,stable,diverged,growth_rate_per_s,early_peak_m,"
       "late_peak_m,ticks\n";
   char buf[256];
   int i = 0;
-  for (const sim::WallRun& w : r.sim.history) {
+  for (const studies::WallRun& w : r.sim.history) {
     std::snprintf(buf, sizeof buf, "%d,%.10g,%d,%d,%.6g,%.9g,%.9g,%d\n", i++,
                   w.k_N_per_m, w.stable ? 1 : 0, w.diverged ? 1 : 0,
                   w.growth_rate_per_s, w.early_peak_m, w.late_peak_m,
@@ -189,16 +189,16 @@ std::string bisection_csv(const sim::StabilityReport& r) {
   return s;
 }
 
-void run_single(const StabilityOptions& o, const sim::StabilityParams& p) {
-  const std::string model = sim::slider_model_path(sim::models_dir());
+void run_single(const StabilityOptions& o, const studies::StabilityParams& p) {
+  const std::string model = studies::slider_model_path(studies::models_dir());
   if (!o.out.empty()) make_out_dir(o.out);
-  sim::StabilityReport r;
+  studies::StabilityReport r;
   try {
-    r = sim::study_stability(model, p, o.tolerance);
+    r = studies::study_stability(model, p, o.tolerance);
   } catch (const sim::SimError& e) {
     throw UsageError(e.what());
   }
-  sim::SliderWall probe(model, p);
+  studies::SliderWall probe(model, p);
   const double k = r.sim.k_crit_N_per_m;
   const double bT_m = p.damping_Ns_per_m * p.servo_period_s / p.mass_kg;
   const double BT_m =
@@ -243,7 +243,7 @@ void run_single(const StabilityOptions& o, const sim::StabilityParams& p) {
   std::cout << dump_readable(j) << '\n';
 }
 
-void run_map(const StabilityOptions& o, const sim::StabilityParams& base) {
+void run_map(const StabilityOptions& o, const studies::StabilityParams& base) {
   if (o.out.empty()) {
     throw UsageError("--map: give --out DIR for stability_map.csv and .svg");
   }
@@ -264,10 +264,10 @@ void run_map(const StabilityOptions& o, const sim::StabilityParams& base) {
     throw UsageError("--map-b-max: the largest B must be > 0 N s/m (got " +
                      number_text(o.map_b_max_Ns_per_m) + ")");
   }
-  sim::MapSpec spec;
+  studies::MapSpec spec;
   spec.base = base;
   spec.rel_tol = o.tolerance;
-  spec.jobs = o.jobs > 0 ? o.jobs : sim::core_count();
+  spec.jobs = o.jobs > 0 ? o.jobs : report::core_count();
   // with b = 0 the sweep starts one step above B = 0, where nothing is
   // stable
   const int first = base.damping_Ns_per_m > 0.0 ? 0 : 1;
@@ -281,9 +281,9 @@ void run_map(const StabilityOptions& o, const sim::StabilityParams& base) {
   }
   make_out_dir(o.out);
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<sim::MapPoint> points;
+  std::vector<studies::MapPoint> points;
   try {
-    points = sim::stability_map(sim::slider_model_path(sim::models_dir()),
+    points = studies::stability_map(studies::slider_model_path(studies::models_dir()),
                                 spec);
   } catch (const sim::SimError& e) {
     throw UsageError(e.what());
@@ -292,14 +292,14 @@ void run_map(const StabilityOptions& o, const sim::StabilityParams& base) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
           .count();
   const fs::path dir(o.out);
-  write_file(dir / "stability_map.csv", sim::stability_map_csv(points));
+  write_file(dir / "stability_map.csv", studies::stability_map_csv(points));
   write_file(dir / "stability_map.svg",
-             sim::stability_map_svg(points, base));
+             studies::stability_map_svg(points, base));
 
   double worst_exact = 0.0, worst_euler = 0.0, worst_gil = 0.0;
   int runs = 0;
   Json rows = Json::array();
-  for (const sim::MapPoint& p : points) {
+  for (const studies::MapPoint& p : points) {
     const double k = p.sim.k_crit_N_per_m;
     worst_exact = std::max(worst_exact, std::abs(rel(k, p.k_crit_exact_N_per_m)));
     worst_euler =
@@ -338,7 +338,7 @@ void run(const StabilityOptions& o) {
                      "[1e-5, 0.1] (got " + number_text(o.tolerance) + ")");
   }
   if (o.jobs < 0) throw UsageError("--jobs: must be >= 1");
-  const sim::StabilityParams p = params_from(o);
+  const studies::StabilityParams p = params_from(o);
   if (o.map) {
     run_map(o, p);
   } else {

@@ -6,7 +6,7 @@
 
 #include <stdexcept>
 
-namespace vmh::sim {
+namespace vmh::report {
 
 void write_file_atomically(const std::string& path, const std::string& text) {
   namespace fs = std::filesystem;
@@ -32,4 +32,4 @@ void write_file_atomically(const std::string& path, const std::string& text) {
   }
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::report

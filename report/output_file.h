@@ -5,13 +5,13 @@
 
 #include <string>
 
-namespace vmh::sim {
+namespace vmh::report {
 
 // Writes `text` to `path` through "<path>.tmp" and a rename (atomic on one
 // file system): readers see the old file or the whole new one. Throws
 // std::runtime_error naming the path when it cannot open, write or rename.
 void write_file_atomically(const std::string& path, const std::string& text);
 
-}  // namespace vmh::sim
+}  // namespace vmh::report
 
 #endif  // VMHAPTICS_REPORT_OUTPUT_FILE_H_

@@ -12,7 +12,7 @@
 
 #include "report/svg_text.h"
 
-namespace vmh::sim {
+namespace vmh::report {
 namespace {
 
 using svg::attr;
@@ -438,4 +438,4 @@ std::string chart_svg(const Chart& chart) {
   return svg;
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::report

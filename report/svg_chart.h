@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-namespace vmh::sim {
+namespace vmh::report {
 
 struct ChartSeries {
   std::string label;        // legend text
@@ -50,6 +50,6 @@ struct Chart {
 // x and y of different lengths.
 std::string chart_svg(const Chart& chart);
 
-}  // namespace vmh::sim
+}  // namespace vmh::report
 
 #endif  // VMHAPTICS_REPORT_SVG_CHART_H_

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <set>
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
 constexpr double kRadToDeg = 57.295779513082320876798;
@@ -336,4 +338,4 @@ std::vector<Claim> measure_claims(int thesis_case,
 }
 
 }  // namespace
-}  // namespace vmh::sim
+}  // namespace vmh::studies

@@ -15,7 +15,9 @@
 #include "report/parallel.h"
 #include "studies/run_case.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace fs = std::filesystem;
 namespace {
 
@@ -397,9 +399,9 @@ ExtremeResult run_extreme(const ExtremeScenario& s,
   return r;
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies
 
-namespace vmh::sim {
+namespace vmh::studies {
 namespace {
 
 
@@ -685,7 +687,7 @@ nlohmann::json run_extremes_study(const std::vector<std::string>& only,
   std::vector<std::vector<double>> energy_t(table.size()), energy_J(table.size());
   std::vector<std::string> errors(table.size());
   const auto start = std::chrono::steady_clock::now();
-  parallel_for(table.size(), jobs, [&](std::size_t i) {
+  report::parallel_for(table.size(), jobs, [&](std::size_t i) {
     std::vector<TraceRow> rows;
     try {
       (*results)[i] = run_extreme(table[i], &rows);
@@ -708,7 +710,7 @@ nlohmann::json run_extremes_study(const std::vector<std::string>& only,
         }
       }
       if (!out_dir.empty()) {
-        write_file_atomically(
+        report::write_file_atomically(
             (fs::path(out_dir) / "extremes" / (table[i].name + ".csv")).string(),
             series_csv(rows));
       }
@@ -742,12 +744,12 @@ nlohmann::json run_extremes_study(const std::vector<std::string>& only,
       {"wall_time_s", wall},
   };
   if (!out_dir.empty()) {
-    write_file_atomically((fs::path(out_dir) / "extremes.csv").string(), extremes_csv(*results));
-    write_file_atomically((fs::path(out_dir) / "extremes.json").string(), j.dump(2) + "\n");
-    write_file_atomically((fs::path(out_dir) / "extremes.svg").string(),
+    report::write_file_atomically((fs::path(out_dir) / "extremes.csv").string(), extremes_csv(*results));
+    report::write_file_atomically((fs::path(out_dir) / "extremes.json").string(), j.dump(2) + "\n");
+    report::write_file_atomically((fs::path(out_dir) / "extremes.svg").string(),
 energy_panels_svg(*results, energy_t, energy_J));
   }
   return j;
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies

@@ -24,7 +24,7 @@
 
 #include "sim/closed_loop.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 struct ExtremeScenario {
   std::string name;
@@ -155,7 +155,7 @@ struct ExtremeResult {
 // Runs one scenario. With `trace` non-null, fills it with every tick's row.
 // Throws SimError on bad input (a bad override, an unreachable start pose).
 ExtremeResult run_extreme(const ExtremeScenario& s,
-                          std::vector<TraceRow>* trace = nullptr);
+                          std::vector<sim::TraceRow>* trace = nullptr);
 
 // Runs every scenario of extreme_scenarios() (or those named in `only`) on
 // `jobs` threads, and, if out_dir is not empty, writes out_dir/extremes.csv,
@@ -171,6 +171,6 @@ nlohmann::json extreme_result_json(const ExtremeResult& r);
 // the CSV's header and one row per result
 std::string extremes_csv(const std::vector<ExtremeResult>& results);
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_EXTREMES_STUDY_H_

@@ -14,7 +14,9 @@
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -290,4 +292,4 @@ std::string leanness_csv(const LeannessResult& r) {
   return s;
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies

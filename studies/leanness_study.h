@@ -32,7 +32,7 @@
 #include <string>
 #include <vector>
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 // what a variant switches on (or, for kNoFrictionloss, off)
 enum Ingredient : unsigned {
@@ -121,6 +121,6 @@ LeannessResult run_leanness_study(const LeannessOptions& options);
 // one row per case and variant, units in the column names
 std::string leanness_csv(const LeannessResult& r);
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_LEANNESS_STUDY_H_

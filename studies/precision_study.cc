@@ -16,7 +16,9 @@
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -448,8 +450,8 @@ std::string precision_csv(const PrecisionResult& r) {
   return s;
 }
 
-Chart precision_chart(const PrecisionResult& r) {
-  Chart c;
+report::Chart precision_chart(const PrecisionResult& r) {
+  report::Chart c;
   char title[160];
   // centred on the plot area, so kept short
   std::snprintf(title, sizeof title, "work-precision, %.3g s, T = %.3g ms",
@@ -460,7 +462,7 @@ Chart precision_chart(const PrecisionResult& r) {
   c.x = {"wall time of the run (s)", true};
   c.y = {"RMS wrist-centre error vs RK4 reference (mm)", true};
   for (const OrderFit& f : r.fits) {
-    ChartSeries s;
+    report::ChartSeries s;
     s.label = integrator_name(f.integrator);
     s.color = colour_of(f.integrator);
     for (const PrecisionRow& row : r.rows) {
@@ -472,7 +474,7 @@ Chart precision_chart(const PrecisionResult& r) {
   }
   for (const PrecisionRow& row : r.rows) {
     if (!row.is_default || !row.error.finite) continue;
-    ChartSeries s;
+    report::ChartSeries s;
     char label[96];
     std::snprintf(label, sizeof label, "default (%s, h = %.3g ms)",
                   integrator_name(row.integrator), row.step_s * 1e3);
@@ -490,7 +492,7 @@ Chart precision_chart(const PrecisionResult& r) {
       lo = std::min(lo, row.wall_time_s);
       hi = std::max(hi, row.wall_time_s);
     }
-    ChartSeries s;
+    report::ChartSeries s;
     s.label = "reference self-error (RK4 " +
               exact(r.reference.check_step_s * 1e6) + " us vs " +
               exact(r.reference.step_s * 1e6) + " us)";
@@ -504,15 +506,15 @@ Chart precision_chart(const PrecisionResult& r) {
   return c;
 }
 
-Chart precision_order_chart(const PrecisionResult& r) {
-  Chart c;
+report::Chart precision_order_chart(const PrecisionResult& r) {
+  report::Chart c;
   c.title = "error against the physics step";
   c.width_px = 820;
   c.height_px = 480;
   c.x = {"physics step h (s)", true};
   c.y = {"RMS wrist-centre error vs RK4 reference (mm)", true};
   for (const OrderFit& f : r.fits) {
-    ChartSeries s;
+    report::ChartSeries s;
     s.color = colour_of(f.integrator);
     s.label = integrator_name(f.integrator);
     for (const PrecisionRow& row : r.rows) {
@@ -522,7 +524,7 @@ Chart precision_order_chart(const PrecisionResult& r) {
     }
     c.series.push_back(s);
     if (f.points >= 2) {
-      ChartSeries line;
+      report::ChartSeries line;
       char label[96];
       std::snprintf(label, sizeof label, "%s fit, order %.2f",
                     integrator_name(f.integrator), f.order);
@@ -541,7 +543,7 @@ Chart precision_order_chart(const PrecisionResult& r) {
     }
   }
   if (r.floor_mm > 0.0 && !r.rows.empty()) {
-    ChartSeries s;
+    report::ChartSeries s;
     s.label = "fit floor (10 x reference self-error)";
     s.color = "#7f7f7f";
     s.markers = false;
@@ -558,4 +560,4 @@ Chart precision_order_chart(const PrecisionResult& r) {
   return c;
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies

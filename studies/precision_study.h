@@ -26,7 +26,7 @@
 #include "sim/hand_script.h"
 #include "report/svg_chart.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 // MuJoCo 2.2.2's integrators: mjINT_EULER (semi-implicit, joint damping
 // implicit), mjINT_RK4 (needs mj_step: mj_step2 falls back to Euler), and
@@ -117,7 +117,7 @@ struct PrecisionResult {
   double duration_s = 0.0;
   double servo_period_s = 0.0;
   int ticks = 0;
-  std::vector<ScriptSegment> segments;  // the script's, as far as the runs go
+  std::vector<sim::ScriptSegment> segments;  // the script's, as far as the runs go
   Integrator default_integrator = Integrator::kEuler;
   double default_step_s = 0.0;
   ReferenceInfo reference;
@@ -149,10 +149,10 @@ std::vector<bool> pareto_front(const std::vector<double>& x,
 std::string precision_csv(const PrecisionResult& r);
 // error (RMS, mm) against wall time (s), log-log, one line per integrator,
 // the default setting and the reference marked
-Chart precision_chart(const PrecisionResult& r);
+report::Chart precision_chart(const PrecisionResult& r);
 // error (RMS, mm) against h (s), log-log, with the fitted slopes
-Chart precision_order_chart(const PrecisionResult& r);
+report::Chart precision_order_chart(const PrecisionResult& r);
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_PRECISION_STUDY_H_

@@ -13,7 +13,9 @@
 #include "report/parallel.h"
 #include "report/svg_chart.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -477,7 +479,7 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
     }
   }
   std::vector<std::exception_ptr> errors(points.size());
-  parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
+  report::parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
     try {
       const StabilityParams& p = params[i];
       MapPoint& pt = points[i];
@@ -535,7 +537,7 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
       delays.push_back(p.delay_ticks);
     }
   }
-  Chart c;
+  report::Chart c;
   char title[256];
   std::snprintf(title, sizeof title,
                 "K_crit of the sampled wall: m = %g kg, b = %g N s/m, "
@@ -552,7 +554,7 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
     const int n = delays[i];
     const std::string color = kColors[i % (sizeof kColors / sizeof *kColors)];
     const std::string tag = "n = " + std::to_string(n);
-    ChartSeries sim, exact, gil;
+    report::ChartSeries sim, exact, gil;
     sim.label = "simulated, " + tag;
     sim.line = false;
     exact.label = "exact discrete, " + tag;
@@ -575,7 +577,7 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
     c.series.push_back(exact);
     c.series.push_back(gil);
   }
-  ChartSeries passive;
+  report::ChartSeries passive;
   passive.label = "passivity 2(b-B)/T (Colgate & Schenkel)";
   passive.markers = false;
   passive.dashed = true;
@@ -596,7 +598,7 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
     passive.y.push_back(0.0);
   }
   if (!passive.x.empty()) c.series.push_back(passive);
-  return chart_svg(c);
+  return report::chart_svg(c);
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies

@@ -59,7 +59,7 @@
 
 #include "sim/mujoco_util.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 // How the controller estimates the velocity for the damper B.
 enum class VelocityEstimate {
@@ -184,8 +184,8 @@ class SliderWall {
 
  private:
   StabilityParams p_;
-  ModelPtr m_;
-  DataPtr d_;
+  sim::ModelPtr m_;
+  sim::DataPtr d_;
   int steps_per_tick_ = 1;
 };
 
@@ -271,6 +271,6 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
 // The slider's model file under `models_dir`.
 std::string slider_model_path(const std::string& models_dir);
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_STABILITY_STUDY_H_

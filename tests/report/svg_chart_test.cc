@@ -24,7 +24,7 @@
 
 #include "tests/support/svg_check.h"
 
-namespace vmh::sim {
+namespace vmh::report {
 namespace {
 
 using vmh::testing::count;
@@ -346,4 +346,4 @@ TEST(SvgChartTest, UnusableLimitsAreIgnoredAndNoted) {
 }
 
 }  // namespace
-}  // namespace vmh::sim
+}  // namespace vmh::report

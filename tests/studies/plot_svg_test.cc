@@ -24,7 +24,8 @@
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/svg_check.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+using namespace vmh::sim;  // NOLINT(build/namespaces): the testbed's types
 namespace {
 
 using vmh::testing::count;
@@ -271,4 +272,4 @@ TEST(PlotSvgTest, HistoryPolylinesAreDecimatedAndLabelled) {
 }
 
 }  // namespace
-}  // namespace vmh::sim
+}  // namespace vmh::studies

@@ -24,7 +24,8 @@
 #include "report/svg_chart.h"
 #include "tests/support/mujoco_guard.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+using namespace vmh::sim;  // NOLINT(build/namespaces): the testbed's types
 namespace {
 
 const std::string kModel = std::string(VMH_MODELS_DIR) + "/slider/slider.xml";
@@ -433,4 +434,4 @@ TEST(StabilityStudyTest, MapTableAndChart) {
 }
 
 }  // namespace
-}  // namespace vmh::sim
+}  // namespace vmh::studies
