@@ -12,6 +12,12 @@ namespace vmh::report {
 // std::runtime_error naming the path when it cannot open, write or rename.
 void write_file_atomically(const std::string& path, const std::string& text);
 
+// Creates `dir` if needed and writes dir/name as write_file_atomically does.
+// Returns the path written. Throws std::runtime_error naming the folder or
+// the path.
+std::string write_file_in(const std::string& dir, const std::string& name,
+                          const std::string& text);
+
 }  // namespace vmh::report
 
 #endif  // VMHAPTICS_REPORT_OUTPUT_FILE_H_
