@@ -1,4 +1,4 @@
-// The stiff and extreme cases (sim/extremes_study.h), one test per scenario,
+// The stiff and extreme cases (studies/extremes_study.h), one test per scenario,
 // and the machinery they rest on: the passivity observer against an
 // independent sum, the servo jitter's draws and clock, the faults' zero
 // torque, and the two instabilities the study names.

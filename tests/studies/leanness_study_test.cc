@@ -1,4 +1,4 @@
-// sim/leanness_study.cc: the scenes as composed against the same scenes with
+// studies/leanness_study.cc: the scenes as composed against the same scenes with
 // contacts, gravity and a viewer's scene update switched on.
 //
 // Performance figures are reported by `vmhaptics study leanness`, never

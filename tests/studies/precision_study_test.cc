@@ -1,4 +1,4 @@
-// sim/precision_study.cc: the work-precision study of the closed loop.
+// studies/precision_study.cc: the work-precision study of the closed loop.
 //
 // Independent truths:
 // - the orders of the integrators: explicit/semi-implicit Euler and MuJoCo's

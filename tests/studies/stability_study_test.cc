@@ -1,4 +1,4 @@
-// sim/stability_study.cc: the critical stiffness of the sampled-data wall,
+// studies/stability_study.cc: the critical stiffness of the sampled-data wall,
 // found by simulating the slider in MuJoCo, against theory (REFERENCE.md
 // §6):
 //   - Gil et al. 2004: K_crit = (b + B)/(T/2 + n T), within 5%, where that
