@@ -16,19 +16,14 @@
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "tests/support/mujoco_guard.h"
+#include "tests/support/thesis_cases.h"
 
 namespace vmh::sim {
 namespace {
 
-std::string scene(int n) {
-  return std::string(VMH_MODELS_DIR) + "/cases/case" + std::to_string(n) +
-         ".xml";
-}
+std::string scene(int n) { return testing::thesis_case_scene(n); }
 
-class CaseTest : public ::testing::TestWithParam<int> {
- protected:
-  testing::MujocoGuard guard_;
-};
+using CaseTest = testing::ThesisCaseTest;
 
 // Every scene runs its whole script with no MuJoCo warning (d->warning all
 // zero, no warning callback), finite state, and no controller fault.

@@ -10,19 +10,14 @@
 
 #include "studies/run_case.h"
 #include "tests/support/mujoco_guard.h"
+#include "tests/support/thesis_cases.h"
 
 namespace vmh::studies {
 namespace {
 
-std::string scene(int n) {
-  return std::string(VMH_MODELS_DIR) + "/cases/case" + std::to_string(n) +
-         ".xml";
-}
+std::string scene(int n) { return testing::thesis_case_scene(n); }
 
-class CaseTest : public ::testing::TestWithParam<int> {
- protected:
-  testing::MujocoGuard guard_;
-};
+using CaseTest = testing::ThesisCaseTest;
 
 // Each claim of the case (studies/claims.cc), measured on a full 20 s run,
 // passes; the measured figure goes in the log and the XML report.
