@@ -36,7 +36,7 @@ namespace {
 
 std::string case_scene(int n) {
   std::string name;
-  return resolve_scene("case" + std::to_string(n), &name);
+  return studies::resolve_scene("case" + std::to_string(n), &name);
 }
 
 std::vector<std::string> setting(int64_t which) {
@@ -94,13 +94,13 @@ void BM_ClosedLoopTick(benchmark::State& state) {
 void BM_RunAll(benchmark::State& state) {
   int claims_failed = 0;
   for (auto _ : state) {
-    std::vector<CaseJob> jobs;
-    for (const CaseEntry& c : thesis_cases()) {
-      jobs.push_back(CaseJob{c.name, case_scene(static_cast<int>(
+    std::vector<studies::CaseJob> jobs;
+    for (const studies::CaseEntry& c : studies::thesis_cases()) {
+      jobs.push_back(studies::CaseJob{c.name, case_scene(static_cast<int>(
                                          jobs.size() + 1)), {}, {}, false});
     }
-    run_cases(&jobs, {}, "", 2);
-    for (const CaseJob& j : jobs) {
+    studies::run_cases(&jobs, {}, "", 2);
+    for (const studies::CaseJob& j : jobs) {
       if (!j.error.empty()) {
         state.SkipWithError(j.error.c_str());
         return;
@@ -108,7 +108,7 @@ void BM_RunAll(benchmark::State& state) {
       claims_failed += j.result.all_claims_pass ? 0 : 1;
     }
   }
-  state.counters["cases"] = static_cast<double>(thesis_cases().size());
+  state.counters["cases"] = static_cast<double>(studies::thesis_cases().size());
   state.counters["claims_failed"] = claims_failed;
 }
 

@@ -29,20 +29,20 @@ struct RunOptions {
   bool json = false;
 };
 
-void print_table(const std::vector<sim::CaseResult>& results) {
+void print_table(const std::vector<studies::CaseResult>& results) {
   std::printf("%-8s %10s %10s %10s %10s %9s %9s %8s  %s\n", "case",
               "sim_s", "wall_s", "rms_mm", "max_mm", "meanF_N", "maxF_N",
               "on_path", "claims");
-  for (const sim::CaseResult& r : results) {
+  for (const studies::CaseResult& r : results) {
     int pass = 0;
-    for (const sim::Claim& c : r.claims) pass += c.pass ? 1 : 0;
+    for (const studies::Claim& c : r.claims) pass += c.pass ? 1 : 0;
     std::printf("%-8s %10.3f %10.3f %10.3f %10.3f %9.3f %9.3f %7.1f%%  %d/%zu%s\n",
                 r.name.c_str(), r.simulated_s, r.wall_time_s,
                 r.metrics.rms_path_error_mm, r.metrics.max_path_error_mm,
                 r.metrics.mean_force_N, r.metrics.max_force_N,
                 100.0 * r.metrics.time_on_path_s / std::max(r.simulated_s, 1e-9),
                 pass, r.claims.size(), r.all_claims_pass ? "" : "  FAIL");
-    for (const sim::Claim& c : r.claims) {
+    for (const studies::Claim& c : r.claims) {
       std::printf("    %-4s %-36s %10.4g %s %-7.4g %-5s at %5.1f mm off\n",
                   c.pass ? "ok" : "FAIL", c.name.c_str(), c.value,
                   c.comparison.c_str(), c.threshold, c.unit.c_str(),
@@ -65,26 +65,26 @@ void run(const RunOptions& o) {
   std::vector<std::pair<std::string, std::string>> jobs;
   try {
     if (o.all) {
-      for (const sim::CaseEntry& c : sim::thesis_cases()) {
+      for (const studies::CaseEntry& c : studies::thesis_cases()) {
         std::string name;
-        jobs.emplace_back(c.name, sim::resolve_scene(c.name, &name));
+        jobs.emplace_back(c.name, studies::resolve_scene(c.name, &name));
       }
     } else {
       std::string name;
-      const std::string scene = sim::resolve_scene(o.target, &name);
+      const std::string scene = studies::resolve_scene(o.target, &name);
       jobs.emplace_back(name, scene);
     }
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("run: ") + e.what());
   }
 
-  std::vector<sim::CaseJob> runs;
+  std::vector<studies::CaseJob> runs;
   for (const auto& [name, scene] : jobs) {
-    runs.push_back(sim::CaseJob{name, scene, {}, {}, false});
+    runs.push_back(studies::CaseJob{name, scene, {}, {}, false});
   }
-  sim::run_cases(&runs, sets, o.out, o.jobs);
-  std::vector<sim::CaseResult> results;
-  for (const sim::CaseJob& j : runs) {
+  studies::run_cases(&runs, sets, o.out, o.jobs);
+  std::vector<studies::CaseResult> results;
+  for (const studies::CaseJob& j : runs) {
     if (!j.error.empty()) {
       const std::string msg = "run " + j.name + ": " + j.error;
       if (j.bad_input) throw UsageError(msg);
@@ -95,7 +95,7 @@ void run(const RunOptions& o) {
 
   if (o.json) {
     nlohmann::json all = nlohmann::json::object();
-    for (const sim::CaseResult& r : results) all[r.name] = r.summary;
+    for (const studies::CaseResult& r : results) all[r.name] = r.summary;
     std::cout << all.dump(2) << '\n';
   } else {
     print_table(results);
@@ -108,8 +108,8 @@ void run(const RunOptions& o) {
   std::fflush(stdout);
 
   std::string failed;
-  for (const sim::CaseResult& r : results) {
-    for (const sim::Claim& c : r.claims) {
+  for (const studies::CaseResult& r : results) {
+    for (const studies::Claim& c : r.claims) {
       if (!c.pass) failed += " " + r.name + ":" + c.name;
     }
   }

@@ -1,6 +1,6 @@
 // vmhaptics study extremes [--out DIR] [--only name ...] [--table] [--jobs N]
 //
-// The stiff and extreme cases of issue 5 (sim/extremes_study.h): gains x10
+// The stiff and extreme cases of issue 5 (studies/extremes_study.h): gains x10
 // and x100, hand stiffness from 10 to 5000 N/m, the RM at the pivot, the
 // sphere's poles, the gimbal's singularity, the arm at full reach, the
 // orientation error across +-pi, servo jitter and sensor faults. Prints one
@@ -24,7 +24,7 @@
 namespace vmh::cli {
 namespace {
 
-struct ExtremesOptions {
+struct ExtremesCli {
   std::string out;
   std::vector<std::string> only;
   bool table = false;
@@ -37,11 +37,11 @@ std::string joined(const std::vector<std::string>& v) {
   return s.empty() ? "-" : s;
 }
 
-void print_table(const std::vector<sim::ExtremeResult>& results) {
+void print_table(const std::vector<studies::ExtremeResult>& results) {
   std::printf("%-24s %-34s %7s %8s %9s %9s %7s  %s\n", "scenario", "outcome",
               "maxF_N", "Emax_mJ", "Efinal_mJ", "rest_mJ", "wall_s",
               "statuses");
-  for (const sim::ExtremeResult& r : results) {
+  for (const studies::ExtremeResult& r : results) {
     std::vector<std::string> named = r.statuses;
     named.insert(named.end(), r.device_errors.begin(), r.device_errors.end());
     named.insert(named.end(), r.guard_faults.begin(), r.guard_faults.end());
@@ -53,24 +53,26 @@ void print_table(const std::vector<sim::ExtremeResult>& results) {
   }
 }
 
-void run(const ExtremesOptions& o) {
-  std::vector<sim::ExtremeResult> results;
-  nlohmann::json j;
+void run(const ExtremesCli& o) {
+  studies::ExtremesOptions p;
+  p.only = o.only;
+  p.out_dir = o.out;
+  p.jobs = o.jobs > 0 ? o.jobs : report::core_count();
+  studies::ExtremesResult r;
   try {
-    j = sim::run_extremes_study(o.only, o.out,
-                                o.jobs > 0 ? o.jobs : sim::core_count(), &results);
+    r = studies::run_extremes_study(p);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study extremes: ") + e.what());
   }
   if (o.table) {
-    print_table(results);
+    print_table(r.scenarios);
   } else {
-    std::cout << j.dump(2) << '\n';
+    std::cout << studies::extremes_json(r).dump(2) << '\n';
   }
   std::cout.flush();
   std::string failed;
-  for (const sim::ExtremeResult& r : results) {
-    if (!r.pass()) failed += " " + r.scenario.name + "(" + r.outcome + ")";
+  for (const studies::ExtremeResult& s : r.scenarios) {
+    if (!s.pass()) failed += " " + s.scenario.name + "(" + s.outcome + ")";
   }
   if (!failed.empty()) {
     throw std::runtime_error("study extremes: scenario(s) failed:" + failed);
@@ -80,7 +82,7 @@ void run(const ExtremesOptions& o) {
 }  // namespace
 
 void register_study_extremes(CLI::App* study) {
-  auto o = std::make_shared<ExtremesOptions>();
+  auto o = std::make_shared<ExtremesCli>();
   CLI::App* cmd = study->add_subcommand(
       "extremes",
       "stiff and extreme cases (gains x10/x100, hand 10-5000 N/m, RM at the "

@@ -1,16 +1,10 @@
 #include "cli/study_files.h"
 
-#include <filesystem>
-#include <fstream>
-#include <stdexcept>
-
 #include "cli/args.h"
 #include "sim/mujoco_util.h"
-#include "report/output_file.h"
 #include "studies/run_case.h"
 
 namespace vmh::cli {
-namespace fs = std::filesystem;
 
 std::string study_scene(const std::string& option, const std::string& value,
                         std::string* name) {
@@ -19,7 +13,7 @@ std::string study_scene(const std::string& option, const std::string& value,
     target = "case" + value;
   }
   try {
-    return sim::resolve_scene(target, name);
+    return studies::resolve_scene(target, name);
   } catch (const sim::SimError& e) {
     throw UsageError(option + ": " + e.what());
   }
@@ -39,16 +33,6 @@ std::vector<double> parse_number_list(const std::string& option,
     ++item;
   }
   return out;
-}
-
-std::string write_study_file(const std::string& dir, const std::string& name,
-                             const std::string& text) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw std::runtime_error(dir + ": " + ec.message());
-  const fs::path path = fs::path(dir) / name;
-  sim::write_file_atomically(path.string(), text);
-  return path.string();
 }
 
 }  // namespace vmh::cli

@@ -3,9 +3,8 @@
 //
 // Steps per second of each case's scene as composed against the same scene
 // with contacts, gravity and a viewer's scene update switched on, each alone
-// and all together (sim/leanness_study.h). Prints one JSON object; with
+// and all together (studies/leanness_study.h). Prints one JSON object; with
 // --out writes DIR/leanness.csv. Exit 2 on bad usage, naming the option.
-#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -23,32 +22,16 @@ namespace {
 
 struct LeannessCli {
   std::vector<std::string> cases;  // empty: the six
-  double duration_s = sim::LeannessOptions{}.duration_s;
-  int repeats = sim::LeannessOptions{}.repeats;
+  double duration_s = studies::LeannessOptions{}.duration_s;
+  int repeats = studies::LeannessOptions{}.repeats;
   std::vector<std::string> sets;
   std::string out;
 };
 
-Json ingredient_names(unsigned ingredients) {
-  Json names = Json::array();
-  if (ingredients & sim::kContacts) names.push_back("contacts");
-  if (ingredients & sim::kGravity) names.push_back("gravity");
-  if (ingredients & sim::kRendering) names.push_back("rendering");
-  if (ingredients & sim::kNoFrictionloss) names.push_back("no_frictionloss");
-  return names;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 void run(const LeannessCli& o) {
-  sim::LeannessOptions p;
+  studies::LeannessOptions p;
   if (o.cases.empty()) {
-    for (const sim::CaseEntry& c : sim::thesis_cases()) {
+    for (const studies::CaseEntry& c : studies::thesis_cases()) {
       std::string name;
       const std::string scene = study_scene("--case", c.name, &name);
       p.scenes.emplace_back(name, scene);
@@ -78,80 +61,15 @@ void run(const LeannessCli& o) {
   }
   p.overrides = o.sets;
 
-  sim::LeannessResult r;
+  p.out_dir = o.out;
+
+  studies::LeannessResult r;
   try {
-    r = sim::run_leanness_study(p);
+    r = studies::run_leanness_study(p);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study leanness: ") + e.what());
   }
-
-  Json cases = Json::array();
-  std::vector<std::vector<double>> slowdowns(sim::leanness_variants().size());
-  for (const sim::CaseLeanness& c : r.cases) {
-    Json variants = Json::array();
-    for (std::size_t i = 0; i < c.variants.size(); ++i) {
-      const sim::VariantResult& v = c.variants[i];
-      slowdowns[i].push_back(v.cpu_slowdown);
-      variants.push_back({
-          {"variant", v.variant.name},
-          {"ingredients", ingredient_names(v.variant.ingredients)},
-          {"wall_time_s", v.wall_time_s},
-          {"cpu_time_s", v.cpu_time_s},
-          {"steps_per_s", v.steps_per_s},
-          {"cpu_steps_per_s", v.cpu_steps_per_s},
-          {"realtime_factor", v.realtime_factor},
-          {"slowdown", v.slowdown},
-          {"cpu_slowdown", v.cpu_slowdown},
-          {"physics_slowdown", v.physics_slowdown},
-          {"contact_enabled", v.contact_enabled},
-          {"colliding_geoms", v.colliding_geoms},
-          {"gravity_enabled", v.gravity_enabled},
-          {"frictionloss_enabled", v.frictionloss_enabled},
-          {"mean_ncon", v.mean_ncon},
-          {"max_ncon", v.max_ncon},
-          {"mean_nefc", v.mean_nefc},
-          {"max_nefc", v.max_nefc},
-          {"scene_geoms", v.scene_geoms},
-          {"render_us_per_tick", v.render_us_per_tick},
-          {"max_deviation_mm", v.max_deviation_mm},
-          {"mujoco_warnings", v.mujoco_warnings},
-      });
-    }
-    cases.push_back({{"case", c.name},
-                     {"scene", c.scene},
-                     {"nv", c.nv},
-                     {"ngeom", c.ngeom},
-                     {"h_s", c.step_s},
-                     {"substeps_per_tick", c.substeps},
-                     {"ticks", c.ticks},
-                     {"controller_cpu_time_s", c.controller_cpu_time_s},
-                     {"variants", variants}});
-  }
-  Json summary = Json::object();
-  for (std::size_t i = 0; i < sim::leanness_variants().size(); ++i) {
-    summary[sim::leanness_variants()[i].name] = {
-        {"median_cpu_slowdown", median(slowdowns[i])}};
-  }
-
-  Json result = {
-      {"study", "leanness"},
-      {"duration_s", r.duration_s},
-      {"script", "each case's whole script, compressed into duration_s"},
-      {"repeats", r.repeats},
-      {"not_measured",
-       {{"full_omni",
-         "every case scene already holds the full Omni (nv = 6): the "
-         "controller reads all six joints and the hand moves them, so no "
-         "lighter model would run the same case"}}},
-      {"median_over_cases", summary},
-      {"cases", cases},
-      {"study_wall_time_s", r.study_wall_time_s},
-  };
-  if (!o.out.empty()) {
-    result["files"] = Json::array(
-        {write_study_file(o.out, "leanness.csv", sim::leanness_csv(r))});
-  }
-  std::cout << dump_readable(result) << '\n';
+  std::cout << dump_readable(studies::leanness_json(r)) << '\n';
 }
 
 }  // namespace

@@ -4,7 +4,7 @@
 //                           [--set name=value ...] [--out DIR]
 //
 // Error of the stylus's trajectory against wall time, per MuJoCo integrator
-// and physics step (sim/precision_study.h). Prints one JSON object; with
+// and physics step (studies/precision_study.h). Prints one JSON object; with
 // --out writes DIR/precision.csv, DIR/precision.svg (error vs wall time) and
 // DIR/precision_order.svg (error vs h). Exit 2 on bad usage, naming the
 // option; nothing is written then.
@@ -26,11 +26,11 @@ namespace {
 
 struct PrecisionCli {
   std::string case_name = "1";
-  double duration_s = sim::PrecisionOptions{}.duration_s;
+  double duration_s = studies::PrecisionOptions{}.duration_s;
   std::string steps;        // empty: the default ladder
   std::string integrators;  // empty: all three
-  double reference_step_s = sim::PrecisionOptions{}.reference_step_s;
-  double reference_check_step_s = sim::PrecisionOptions{}.reference_check_step_s;
+  double reference_step_s = studies::PrecisionOptions{}.reference_step_s;
+  double reference_check_step_s = studies::PrecisionOptions{}.reference_check_step_s;
   std::vector<std::string> sets;
   std::string out;
 };
@@ -47,24 +47,29 @@ bool divides(double step_s, double period_s) {
   return n >= 1.0 && std::abs(n * step_s - period_s) <= 1e-9 * period_s;
 }
 
-// NaN (a run that blew up) as JSON null
-Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(); }
-
-Json error_json(const sim::TrajectoryError& e) {
-  return {{"rms_error_mm", number_or_null(e.rms_mm)},
-          {"max_error_mm", number_or_null(e.max_mm)},
-          {"rms_axis_error_rad", number_or_null(e.rms_axis_rad)},
-          {"max_axis_error_rad", number_or_null(e.max_axis_rad)},
-          {"rms_torque_diff_mNm", number_or_null(e.rms_torque_mNm)},
-          {"status_mismatch_ticks", e.status_mismatch_ticks},
-          {"iteration_mismatch_ticks", e.iteration_mismatch_ticks},
-          {"finite", e.finite}};
+// "euler,rk4" as integrators; UsageError naming --integrators otherwise
+std::vector<studies::Integrator> parse_integrators(const std::string& text) {
+  std::vector<studies::Integrator> out;
+  std::string::size_type start = 0;
+  while (true) {
+    const auto comma = text.find(',', start);
+    const std::string item = text.substr(start, comma - start);
+    studies::Integrator i;
+    if (!studies::parse_integrator(item, &i)) {
+      throw UsageError("--integrators: unknown integrator '" + item +
+                       "' (euler, implicit or rk4)");
+    }
+    out.push_back(i);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
 }
 
-void run(const PrecisionCli& o) {
-  sim::PrecisionOptions p;
-  std::string name;
-  p.scene = study_scene("--case", o.case_name, &name);
+// The options as the study takes them, each checked on its own.
+studies::PrecisionOptions to_options(const PrecisionCli& o) {
+  studies::PrecisionOptions p;
+  p.scene = study_scene("--case", o.case_name, &p.name);
   if (!(o.duration_s > 0.0)) {
     throw UsageError("--duration: must be > 0 (s), got " + g(o.duration_s));
   }
@@ -75,22 +80,7 @@ void run(const PrecisionCli& o) {
       if (!(h > 0.0)) throw UsageError("--steps: every step must be > 0 (s)");
     }
   }
-  if (!o.integrators.empty()) {
-    p.integrators.clear();
-    std::string::size_type start = 0;
-    while (true) {
-      const auto comma = o.integrators.find(',', start);
-      const std::string item = o.integrators.substr(start, comma - start);
-      sim::Integrator i;
-      if (!sim::parse_integrator(item, &i)) {
-        throw UsageError("--integrators: unknown integrator '" + item +
-                         "' (euler, implicit or rk4)");
-      }
-      p.integrators.push_back(i);
-      if (comma == std::string::npos) break;
-      start = comma + 1;
-    }
-  }
+  if (!o.integrators.empty()) p.integrators = parse_integrators(o.integrators);
   p.reference_step_s = o.reference_step_s;
   p.reference_check_step_s = o.reference_check_step_s;
   for (const std::string& set : o.sets) {
@@ -101,8 +91,13 @@ void run(const PrecisionCli& o) {
     }
   }
   p.overrides = o.sets;
+  p.out_dir = o.out;
+  return p;
+}
 
-  // the case's servo period and script length, to check the options against
+// The options against the case: its servo period and script length (the
+// study checks them too, but here the error names the option).
+void check_against_case(const studies::PrecisionOptions& p) {
   double period_s = 0.0, script_s = 0.0;
   try {
     sim::ClosedLoop probe(p.scene, p.overrides);
@@ -111,8 +106,8 @@ void run(const PrecisionCli& o) {
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study precision: ") + e.what());
   }
-  if (o.duration_s > script_s) {
-    throw UsageError("--duration: " + g(o.duration_s) +
+  if (p.duration_s > script_s) {
+    throw UsageError("--duration: " + g(p.duration_s) +
                      " s is beyond the case's script (duration_s = " +
                      g(script_s) + " s)");
   }
@@ -121,136 +116,34 @@ void run(const PrecisionCli& o) {
       throw UsageError("--steps: " + g(h) + " s does not divide the servo "
                        "period " + g(period_s) + " s");
     }
-    if (!(h > o.reference_step_s)) {
+    if (!(h > p.reference_step_s)) {
       throw UsageError("--steps: " + g(h) + " s is not above the reference "
-                       "step " + g(o.reference_step_s) + " s");
+                       "step " + g(p.reference_step_s) + " s");
     }
   }
-  if (!(o.reference_step_s > 0.0) || !divides(o.reference_step_s, period_s)) {
+  if (!(p.reference_step_s > 0.0) || !divides(p.reference_step_s, period_s)) {
     throw UsageError("--reference-step: must be > 0 and divide the servo "
                      "period " + g(period_s) + " s, got " +
-                     g(o.reference_step_s));
+                     g(p.reference_step_s));
   }
-  if (!(o.reference_check_step_s > o.reference_step_s) ||
-      !divides(o.reference_check_step_s, period_s)) {
+  if (!(p.reference_check_step_s > p.reference_step_s) ||
+      !divides(p.reference_check_step_s, period_s)) {
     throw UsageError("--reference-check-step: must be above --reference-step "
                      "and divide the servo period " + g(period_s) +
-                     " s, got " + g(o.reference_check_step_s));
+                     " s, got " + g(p.reference_check_step_s));
   }
+}
 
-  sim::PrecisionResult r;
+void run(const PrecisionCli& o) {
+  const studies::PrecisionOptions p = to_options(o);
+  check_against_case(p);
+  studies::PrecisionResult r;
   try {
-    r = sim::run_precision_study(p);
+    r = studies::run_precision_study(p);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study precision: ") + e.what());
   }
-
-  Json rows = Json::array();
-  for (const sim::PrecisionRow& row : r.rows) {
-    Json j = {{"integrator", sim::integrator_name(row.integrator)},
-              {"h_s", row.step_s},
-              {"substeps_per_tick", row.substeps}};
-    j.update(error_json(row.error));
-    j.update(Json{{"wall_time_s", row.wall_time_s},
-                  {"cpu_time_s", row.cpu_time_s},
-                  {"repeats", row.repeats},
-                  {"steps_per_s", row.steps_per_s},
-                  {"realtime_factor", row.realtime_factor},
-                  {"local_order", number_or_null(row.local_order)},
-                  {"used_in_fit", row.used_in_fit},
-                  {"on_front", row.on_front},
-                  {"on_front_cpu", row.on_front_cpu},
-                  {"is_default", row.is_default},
-                  {"mujoco_warnings", row.mujoco_warnings}});
-    rows.push_back(j);
-  }
-  Json orders = Json::array();
-  for (const sim::OrderFit& f : r.fits) {
-    orders.push_back({{"integrator", sim::integrator_name(f.integrator)},
-                      {"order", number_or_null(f.order)},
-                      {"log10_coefficient", number_or_null(f.log10_coefficient)},
-                      {"points", f.points},
-                      {"h_used_s", f.steps_used_s}});
-  }
-  Json def = Json::object();
-  for (const sim::PrecisionRow& row : r.rows) {
-    if (!row.is_default) continue;
-    def = {{"integrator", sim::integrator_name(row.integrator)},
-           {"h_s", row.step_s},
-           {"rms_error_mm", number_or_null(row.error.rms_mm)},
-           {"max_error_mm", number_or_null(row.error.max_mm)},
-           {"wall_time_s", row.wall_time_s},
-           {"cpu_time_s", row.cpu_time_s},
-           {"on_front", row.on_front},
-           {"on_front_cpu", row.on_front_cpu}};
-    // the settings that beat it on both error and time
-    Json better = Json::array();
-    for (const sim::PrecisionRow& other : r.rows) {
-      if (other.error.finite && row.error.finite &&
-          other.error.rms_mm < row.error.rms_mm &&
-          other.wall_time_s < row.wall_time_s) {
-        better.push_back({{"integrator", sim::integrator_name(other.integrator)},
-                          {"h_s", other.step_s}});
-      }
-    }
-    def["dominated_by"] = better;
-  }
-  if (def.empty()) {
-    // the default integrator was left out with --integrators
-    def = {{"integrator", sim::integrator_name(r.default_integrator)},
-           {"h_s", r.default_step_s},
-           {"on_front", nullptr},
-           {"on_front_cpu", nullptr}};
-  }
-  Json front = Json::array();
-  for (const sim::PrecisionRow& row : r.rows) {
-    if (row.on_front) {
-      front.push_back({{"integrator", sim::integrator_name(row.integrator)},
-                       {"h_s", row.step_s}});
-    }
-  }
-
-  Json segments = Json::array();
-  for (const sim::ScriptSegment& seg : r.segments) {
-    segments.push_back({{"name", seg.name}, {"t0_s", seg.t0_s}, {"t1_s", seg.t1_s}});
-  }
-  Json result = {
-      {"study", "precision"},
-      {"case", name},
-      {"scene", r.scene},
-      {"duration_s", r.duration_s},
-      {"servo_period_s", r.servo_period_s},
-      {"ticks", r.ticks},
-      {"quantize", 0},
-      {"segments", segments},
-      {"trajectory",
-       "true wrist centre (omni_fk of MuJoCo's joint angles, device frame) "
-       "and stylus axis at the end of every servo tick"},
-      {"reference",
-       {{"integrator", "rk4"},
-        {"h_s", r.reference.step_s},
-        {"wall_time_s", r.reference.wall_time_s},
-        {"check_h_s", r.reference.check_step_s},
-        {"check_wall_time_s", r.reference.check_wall_time_s},
-        {"self_error", error_json(r.reference.self_error)}}},
-      {"fit_floor_mm", r.floor_mm},
-      {"orders", orders},
-      {"default", def},
-      {"front", front},
-      {"rows", rows},
-      {"study_wall_time_s", r.study_wall_time_s},
-  };
-  if (!o.out.empty()) {
-    Json files = Json::array();
-    files.push_back(write_study_file(o.out, "precision.csv", sim::precision_csv(r)));
-    files.push_back(write_study_file(o.out, "precision.svg",
-                                     sim::chart_svg(sim::precision_chart(r))));
-    files.push_back(write_study_file(
-        o.out, "precision_order.svg",
-        sim::chart_svg(sim::precision_order_chart(r))));
-    result["files"] = files;
-  }
-  std::cout << dump_readable(result) << '\n';
+  std::cout << dump_readable(studies::precision_json(r)) << '\n';
 }
 
 }  // namespace

@@ -15,11 +15,9 @@
 // DIR/stability_map.svg, K_crit against B for each delay.
 // Exit codes: 0 done; 2 bad usage or input; 1 anything else.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -28,18 +26,16 @@
 #include "cli/args.h"
 #include "cli/json_util.h"
 #include "cli/study.h"
-#include "report/output_file.h"
 #include "report/parallel.h"
 #include "studies/run_case.h"
 #include "studies/stability_study.h"
-#include "report/svg_chart.h"
 
 namespace vmh::cli {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct StabilityOptions {
+struct StabilityCli {
   double mass_kg = 0.0;
   double damping_Ns_per_m = 0.0;
   double servo_period_s = 0.0;
@@ -67,10 +63,6 @@ constexpr int kDefaultStepsPerTick = 1000;
 // the points
 constexpr double kDefaultMapBMaxTimesMOverT = 0.1;
 
-void write_file(const fs::path& path, const std::string& text) {
-  sim::write_file_atomically(path.string(), text);
-}
-
 void make_out_dir(const std::string& out) {
   std::error_code ec;
   fs::create_directories(out, ec);
@@ -81,8 +73,8 @@ void make_out_dir(const std::string& out) {
 
 // The parameters, checked. For --map, B is the sweep's and is checked per
 // point; here it stands at 1 N s/m so that b = 0 passes.
-sim::StabilityParams params_from(const StabilityOptions& o) {
-  sim::StabilityParams p;
+studies::StabilityParams params_from(const StabilityCli& o) {
+  studies::StabilityParams p;
   p.mass_kg = o.mass_kg;
   p.damping_Ns_per_m = o.damping_Ns_per_m;
   p.servo_period_s = o.servo_period_s;
@@ -93,7 +85,7 @@ sim::StabilityParams params_from(const StabilityOptions& o) {
     p.physics_step_s = o.servo_period_s / kDefaultStepsPerTick;
   }
   try {
-    sim::validate(p);
+    studies::validate(p);
   } catch (const sim::SimError& e) {
     throw UsageError(e.what());
   }
@@ -107,143 +99,28 @@ std::string number_text(double v) {
   return buf;
 }
 
-double rel(double value, double reference) {
-  return reference != 0.0 ? value / reference - 1.0 : std::nan("");
-}
-
-Json inputs_json(const sim::StabilityParams& p, bool with_controller) {
-  Json j = Json::object();
-  j["mass_kg"] = p.mass_kg;
-  j["damping_Ns_per_m"] = p.damping_Ns_per_m;
-  j["servo_period_s"] = p.servo_period_s;
-  if (with_controller) {
-    j["virtual_damping_Ns_per_m"] = p.virtual_damping_Ns_per_m;
-    j["delay_ticks"] = p.delay_ticks;
-    j["delay_s"] = p.delay_ticks * p.servo_period_s;
-  }
-  j["physics_step_s"] = p.physics_step_s;
-  j["steps_per_tick"] = sim::steps_per_tick(p);
-  j["velocity_estimate"] = "backward difference (x_k - x_{k-1})/T";
-  j["initial_displacement_m"] = sim::kInitialDisplacement_m;
-  return j;
-}
-
-// the bisection's runs: growth rate against K, the theories' K as vertical
-// lines
-std::string bisection_svg(const sim::StabilityReport& r) {
-  sim::Chart c;
-  char title[200];
-  std::snprintf(title, sizeof title,
-                "Bisection on K: m = %g kg, b = %g N s/m, T = %g ms, B = %g "
-                "N s/m, n = %d",
-                r.params.mass_kg, r.params.damping_Ns_per_m,
-                1e3 * r.params.servo_period_s,
-                r.params.virtual_damping_Ns_per_m, r.params.delay_ticks);
-  c.title = title;
-  c.x.label = "stiffness K (N/m)";
-  c.y.label = "envelope growth rate (1/s)";
-  c.width_px = 820;
-  sim::ChartSeries runs;
-  runs.label = "simulated runs";
-  runs.line = false;
-  double lo = 0.0, hi = 0.0;
-  for (const sim::WallRun& w : r.sim.history) {
-    if (w.diverged) continue;  // off the scale
-    runs.x.push_back(w.k_N_per_m);
-    runs.y.push_back(w.growth_rate_per_s);
-    lo = std::min(lo, w.growth_rate_per_s);
-    hi = std::max(hi, w.growth_rate_per_s);
-  }
-  c.series.push_back(runs);
-  auto vertical = [&](const std::string& label, double k, const char* color,
-                      bool dashed) {
-    sim::ChartSeries s;
-    s.label = label;
-    s.x = {k, k};
-    s.y = {lo, hi};
-    s.markers = false;
-    s.dashed = dashed;
-    s.color = color;
-    c.series.push_back(s);
-  };
-  vertical("K_crit simulated", r.sim.k_crit_N_per_m, "#1f77b4", false);
-  vertical("exact discrete", r.exact.k_crit_N_per_m, "#2ca02c", true);
-  vertical("Gil et al. (b+B)/(T/2+nT)", r.k_bound_gil_N_per_m, "#d62728",
-           true);
-  return sim::chart_svg(c);
-}
-
-std::string bisection_csv(const sim::StabilityReport& r) {
-  std::string s =
-      "run,k_N_per_m,stable,diverged,growth_rate_per_s,early_peak_m,"
-      "late_peak_m,ticks\n";
-  char buf[256];
-  int i = 0;
-  for (const sim::WallRun& w : r.sim.history) {
-    std::snprintf(buf, sizeof buf, "%d,%.10g,%d,%d,%.6g,%.9g,%.9g,%d\n", i++,
-                  w.k_N_per_m, w.stable ? 1 : 0, w.diverged ? 1 : 0,
-                  w.growth_rate_per_s, w.early_peak_m, w.late_peak_m,
-                  w.ticks);
-    s += buf;
-  }
-  return s;
-}
-
-void run_single(const StabilityOptions& o, const sim::StabilityParams& p) {
-  const std::string model = sim::slider_model_path(sim::models_dir());
-  if (!o.out.empty()) make_out_dir(o.out);
-  sim::StabilityReport r;
+// the study, its bad input as bad usage, and its JSON on stdout
+void run_study(const studies::StabilityOptions& p) {
+  studies::StabilityResult r;
   try {
-    r = sim::study_stability(model, p, o.tolerance);
+    r = studies::run_stability_study(p);
   } catch (const sim::SimError& e) {
     throw UsageError(e.what());
   }
-  sim::SliderWall probe(model, p);
-  const double k = r.sim.k_crit_N_per_m;
-  const double bT_m = p.damping_Ns_per_m * p.servo_period_s / p.mass_kg;
-  const double BT_m =
-      p.virtual_damping_Ns_per_m * p.servo_period_s / p.mass_kg;
-
-  Json j = Json::object();
-  j["study"] = "stability";
-  j["model"] = model;
-  j["inputs"] = inputs_json(p, true);
-  j["k_crit_N_per_m"] = k;
-  j["k_stable_N_per_m"] = r.sim.k_stable_N_per_m;
-  j["k_unstable_N_per_m"] = r.sim.k_unstable_N_per_m;
-  j["tolerance"] = o.tolerance;
-  j["bound"] = Json{{"source", "Gil, Avello, Rubio and Florez 2004"},
-                    {"formula", "(b + B) / (T/2 + n T)"},
-                    {"k_N_per_m", r.k_bound_gil_N_per_m}};
-  j["k_bound_gil_N_per_m"] = r.k_bound_gil_N_per_m;
-  j["k_crit_exact_discrete_N_per_m"] = r.exact.k_crit_N_per_m;
-  j["k_crit_mujoco_euler_discrete_N_per_m"] = r.euler.k_crit_N_per_m;
-  j["k_passivity_N_per_m"] = r.k_passivity_N_per_m;
-  j["rel_error_vs_gil"] = rel(k, r.k_bound_gil_N_per_m);
-  j["rel_error_vs_exact_discrete"] = rel(k, r.exact.k_crit_N_per_m);
-  j["rel_error_vs_mujoco_euler_discrete"] = rel(k, r.euler.k_crit_N_per_m);
-  j["rel_error_gil_vs_exact_discrete"] =
-      rel(r.k_bound_gil_N_per_m, r.exact.k_crit_N_per_m);
-  // Gil et al.'s first-order bound holds while these are small
-  j["bT_over_m"] = bT_m;
-  j["BT_over_m"] = BT_m;
-  j["iterations"] = Json{{"sim_runs", r.sim.runs},
-                         {"physics_steps", r.sim.physics_steps},
-                         {"eigen_evaluations_exact", r.exact.iterations},
-                         {"eigen_evaluations_euler", r.euler.iterations}};
-  j["horizon_ticks_at_k_crit"] = probe.horizon_ticks(k);
-  j["wall_time_s"] = r.wall_time_s;
-  if (!o.out.empty()) {
-    const fs::path dir(o.out);
-    write_file(dir / "stability_bisection.csv", bisection_csv(r));
-    write_file(dir / "stability_bisection.svg", bisection_svg(r));
-    j["outputs"] = Json{(dir / "stability_bisection.csv").string(),
-                        (dir / "stability_bisection.svg").string()};
-  }
-  std::cout << dump_readable(j) << '\n';
+  std::cout << dump_readable(studies::stability_json(r)) << '\n';
 }
 
-void run_map(const StabilityOptions& o, const sim::StabilityParams& base) {
+void run_single(const StabilityCli& o, const studies::StabilityParams& p) {
+  studies::StabilityOptions so;
+  so.model_path = studies::slider_model_path(studies::models_dir());
+  so.params = p;
+  so.rel_tol = o.tolerance;
+  so.out_dir = o.out;
+  if (!o.out.empty()) make_out_dir(o.out);
+  run_study(so);
+}
+
+void run_map(const StabilityCli& o, const studies::StabilityParams& base) {
   if (o.out.empty()) {
     throw UsageError("--map: give --out DIR for stability_map.csv and .svg");
   }
@@ -264,81 +141,34 @@ void run_map(const StabilityOptions& o, const sim::StabilityParams& base) {
     throw UsageError("--map-b-max: the largest B must be > 0 N s/m (got " +
                      number_text(o.map_b_max_Ns_per_m) + ")");
   }
-  sim::MapSpec spec;
-  spec.base = base;
-  spec.rel_tol = o.tolerance;
-  spec.jobs = o.jobs > 0 ? o.jobs : sim::core_count();
+  studies::StabilityOptions so;
+  so.model_path = studies::slider_model_path(studies::models_dir());
+  so.params = base;
+  so.rel_tol = o.tolerance;
+  so.jobs = o.jobs > 0 ? o.jobs : report::core_count();
   // with b = 0 the sweep starts one step above B = 0, where nothing is
   // stable
   const int first = base.damping_Ns_per_m > 0.0 ? 0 : 1;
   for (int i = first; i < o.map_points + first; ++i) {
-    spec.virtual_damping_Ns_per_m.push_back(b_max * i / (o.map_points - 1));
+    so.map_virtual_damping_Ns_per_m.push_back(b_max * i / (o.map_points - 1));
   }
   if (o.delay_given) {
-    spec.delay_ticks = {o.delay_ticks};
+    so.map_delay_ticks = {o.delay_ticks};
   } else {
-    spec.delay_ticks = {0, 1, 2};
+    so.map_delay_ticks = {0, 1, 2};
   }
+  so.out_dir = o.out;
   make_out_dir(o.out);
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<sim::MapPoint> points;
-  try {
-    points = sim::stability_map(sim::slider_model_path(sim::models_dir()),
-                                spec);
-  } catch (const sim::SimError& e) {
-    throw UsageError(e.what());
-  }
-  const double wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
-          .count();
-  const fs::path dir(o.out);
-  write_file(dir / "stability_map.csv", sim::stability_map_csv(points));
-  write_file(dir / "stability_map.svg",
-             sim::stability_map_svg(points, base));
-
-  double worst_exact = 0.0, worst_euler = 0.0, worst_gil = 0.0;
-  int runs = 0;
-  Json rows = Json::array();
-  for (const sim::MapPoint& p : points) {
-    const double k = p.sim.k_crit_N_per_m;
-    worst_exact = std::max(worst_exact, std::abs(rel(k, p.k_crit_exact_N_per_m)));
-    worst_euler =
-        std::max(worst_euler, std::abs(rel(k, p.k_crit_mujoco_euler_N_per_m)));
-    worst_gil = std::max(worst_gil, std::abs(rel(k, p.k_bound_gil_N_per_m)));
-    runs += p.sim.runs;
-    rows.push_back(Json{p.virtual_damping_Ns_per_m, p.delay_ticks, k,
-                        p.k_crit_exact_N_per_m, p.k_bound_gil_N_per_m});
-  }
-  Json j = Json::object();
-  j["study"] = "stability";
-  j["mode"] = "map";
-  j["inputs"] = inputs_json(base, false);
-  j["virtual_damping_Ns_per_m"] = spec.virtual_damping_Ns_per_m;
-  j["delay_ticks"] = spec.delay_ticks;
-  j["tolerance"] = o.tolerance;
-  j["points"] = points.size();
-  j["columns"] = Json{"virtual_damping_Ns_per_m", "delay_ticks",
-                      "k_crit_sim_N_per_m", "k_crit_exact_N_per_m",
-                      "k_bound_gil_N_per_m"};
-  j["rows"] = rows;
-  j["max_abs_rel_error_sim_vs_exact"] = worst_exact;
-  j["max_abs_rel_error_sim_vs_mujoco_euler"] = worst_euler;
-  j["max_abs_rel_error_sim_vs_gil"] = worst_gil;
-  j["sim_runs"] = runs;
-  j["jobs"] = spec.jobs;
-  j["wall_time_s"] = wall_s;
-  j["outputs"] = Json{(dir / "stability_map.csv").string(),
-                      (dir / "stability_map.svg").string()};
-  std::cout << dump_readable(j) << '\n';
+  run_study(so);
 }
 
-void run(const StabilityOptions& o) {
+void run(const StabilityCli& o) {
   if (!(o.tolerance >= 1e-5 && o.tolerance <= 0.1)) {
     throw UsageError("--tolerance: the relative bracket width must be in "
                      "[1e-5, 0.1] (got " + number_text(o.tolerance) + ")");
   }
   if (o.jobs < 0) throw UsageError("--jobs: must be >= 1");
-  const sim::StabilityParams p = params_from(o);
+  const studies::StabilityParams p = params_from(o);
   if (o.map) {
     run_map(o, p);
   } else {
@@ -349,7 +179,7 @@ void run(const StabilityOptions& o) {
 }  // namespace
 
 void register_study_stability(CLI::App* study) {
-  auto o = std::make_shared<StabilityOptions>();
+  auto o = std::make_shared<StabilityCli>();
   CLI::App* cmd = study->add_subcommand(
       "stability",
       "critical stiffness K_crit of a sampled-data virtual wall on a 1-DOF "

@@ -6,7 +6,7 @@
 
 #include <stdexcept>
 
-namespace vmh::sim {
+namespace vmh::report {
 
 void write_file_atomically(const std::string& path, const std::string& text) {
   namespace fs = std::filesystem;
@@ -32,4 +32,15 @@ void write_file_atomically(const std::string& path, const std::string& text) {
   }
 }
 
-}  // namespace vmh::sim
+std::string write_file_in(const std::string& dir, const std::string& name,
+                          const std::string& text) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir + ": " + ec.message());
+  const std::string path = (fs::path(dir) / name).string();
+  write_file_atomically(path, text);
+  return path;
+}
+
+}  // namespace vmh::report

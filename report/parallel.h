@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-namespace vmh::sim {
+namespace vmh::report {
 
 // the number of hardware threads, at least 1
 inline int core_count() {
@@ -35,6 +35,6 @@ void parallel_for(std::size_t n, int threads, Body body) {
   for (std::thread& t : pool) t.join();
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::report
 
 #endif  // VMHAPTICS_REPORT_PARALLEL_H_

@@ -7,12 +7,13 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
 #include "report/svg_text.h"
 
-namespace vmh::sim {
+namespace vmh::report {
 namespace {
 
 using svg::attr;
@@ -219,223 +220,351 @@ Kept keep(const ChartSeries& s, bool xlog, bool ylog) {
   return k;
 }
 
-}  // namespace
 
-std::string chart_svg(const Chart& chart) {
+// ---------------------------------------------------------------- a chart
+
+constexpr double kSubtitleRow = 14.0;  // the top margin grows by it
+
+// What is drawn, in data units: the series' points, the axes' ranges and
+// colours, and what was left out (for the <desc>).
+struct Prepared {
+  std::vector<Kept> kept;  // one per series
+  std::vector<std::string> colors;
+  std::size_t non_finite = 0, non_positive = 0, points = 0;
+  double x0 = 0.0, x1 = 1.0, y0 = 0.0, y1 = 1.0;
+  std::string notes;  // axis limits that were ignored
+};
+
+void check_lengths(const Chart& chart, const std::string& where) {
   for (std::size_t i = 0; i < chart.series.size(); ++i) {
     const ChartSeries& s = chart.series[i];
     if (s.x.size() != s.y.size()) {
       throw std::invalid_argument(
-          "chart_svg: series " + std::to_string(i) + " ('" + s.label +
+          where + ": series " + std::to_string(i) + " ('" + s.label +
           "') has " + std::to_string(s.x.size()) + " x values but " +
           std::to_string(s.y.size()) + " y values");
     }
   }
+}
 
-  // the points to draw, and the data's extent
-  std::vector<Kept> kept;
-  std::size_t n_non_finite = 0, n_non_positive = 0, n_points = 0;
+Prepared prepare(const Chart& chart) {
+  Prepared p;
   double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo;
   double ylo = xlo, yhi = -xlo;
+  std::size_t next_color = 0;
   for (const ChartSeries& s : chart.series) {
-    kept.push_back(keep(s, chart.x.log, chart.y.log));
-    const Kept& k = kept.back();
-    n_non_finite += k.non_finite;
-    n_non_positive += k.non_positive;
-    n_points += k.pts.size();
+    p.kept.push_back(keep(s, chart.x.log, chart.y.log));
+    const Kept& k = p.kept.back();
+    p.non_finite += k.non_finite;
+    p.non_positive += k.non_positive;
+    p.points += k.pts.size();
     for (const auto& [x, y] : k.pts) {
       xlo = std::min(xlo, x);
       xhi = std::max(xhi, x);
       ylo = std::min(ylo, y);
       yhi = std::max(yhi, y);
     }
+    // colours: given, or the next of the palette
+    p.colors.push_back(s.color.empty() ? kPalette[next_color++ % kPaletteSize]
+                                       : s.color);
   }
+  std::tie(p.x0, p.x1) = axis_range(chart.x, xlo, xhi, "x", &p.notes);
+  std::tie(p.y0, p.y1) = axis_range(chart.y, ylo, yhi, "y", &p.notes);
+  return p;
+}
 
-  std::string notes;
-  const auto [x0, x1] = axis_range(chart.x, xlo, xhi, "x", &notes);
-  const auto [y0, y1] = axis_range(chart.y, ylo, yhi, "y", &notes);
+// Where things go, in pixels: the plot area, with the legend (series with a
+// label) to its right.
+struct Layout {
+  double W = 1.0, H = 1.0;
+  double left = 0.0, top = 0.0, plot_w = 0.0, plot_h = 0.0, bottom = 0.0;
+  std::size_t legend_rows = 0;
+};
 
-  // colours: given, or the next of the palette
-  std::vector<std::string> colors;
-  std::size_t next_color = 0;
-  for (const ChartSeries& s : chart.series) {
-    colors.push_back(s.color.empty() ? kPalette[next_color++ % kPaletteSize]
-                                     : s.color);
-  }
-
-  // the legend (series with a label) right of the plot area
-  const double W = std::max(chart.width_px, 1);
-  const double H = std::max(chart.height_px, 1);
-  std::size_t legend_chars = 0, legend_rows = 0;
+Layout layout(const Chart& chart) {
+  Layout l;
+  l.W = std::max(chart.width_px, 1);
+  l.H = std::max(chart.height_px, 1);
+  std::size_t legend_chars = 0;
   for (const ChartSeries& s : chart.series) {
     if (s.label.empty()) continue;
     legend_chars = std::max(legend_chars, s.label.size());
-    ++legend_rows;
+    ++l.legend_rows;
   }
   double legend_w = 0.0;
-  if (legend_rows > 0) {
+  if (l.legend_rows > 0) {
     legend_w = std::min(kLegendSample + 8.0 +
                             kCharWidth * static_cast<double>(legend_chars) + 8.0,
-                        0.4 * W);
+                        0.4 * l.W);
   }
-  const double left = kMarginLeft;
-  const double top = kMarginTop;
-  const double plot_w = std::max(
-      kMinPlot, W - kMarginLeft - kMarginRight -
-                    (legend_w > 0.0 ? legend_w + kLegendGap : 0.0));
-  const double plot_h = std::max(kMinPlot, H - kMarginTop - kMarginBottom);
-  const double bottom = top + plot_h;
+  const double margin_top =
+      kMarginTop + (chart.subtitle.empty() ? 0.0 : kSubtitleRow);
+  l.left = kMarginLeft;
+  l.top = margin_top;
+  l.plot_w = std::max(kMinPlot, l.W - kMarginLeft - kMarginRight -
+                                    (legend_w > 0.0 ? legend_w + kLegendGap : 0.0));
+  l.plot_h = std::max(kMinPlot, l.H - margin_top - kMarginBottom);
+  l.bottom = l.top + l.plot_h;
+  return l;
+}
 
-  Scale sx{chart.x.log, x0, x1, left, left + plot_w};
-  Scale sy{chart.y.log, y0, y1, bottom, top};  // y up
-
-  std::string svg =
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\"" +
-      attr("class", "chart") + attr("width", px(W)) + attr("height", px(H)) +
-      attr("viewBox", "0 0 " + px(W) + " " + px(H)) +
-      " font-family=\"sans-serif\" font-size=\"11\">\n";
+// <title>, <desc>, the white ground, the plot area's clip path and the
+// title (and subtitle) as text
+std::string head_svg(const Chart& chart, const Prepared& p, const Layout& l,
+                     const std::string& id) {
+  std::string svg;
   if (!chart.title.empty()) svg += "<title>" + escape(chart.title) + "</title>\n";
-  {
-    std::string d = std::to_string(chart.series.size()) + " series, " +
-                    std::to_string(n_points) + " points drawn. Dropped: " +
-                    std::to_string(n_non_finite) + " non-finite point(s), " +
-                    std::to_string(n_non_positive) +
-                    " non-positive point(s) on a log axis.";
-    svg += "<desc>" + escape(d + notes) + "</desc>\n";
-  }
-  svg += "<rect" + attr("x", "0") + attr("y", "0") + attr("width", px(W)) +
-         attr("height", px(H)) + attr("fill", "white") + "/>\n";
-  {
-    // the series are clipped to the plot area, widened by a marker so that
-    // a point on an axis limit shows whole
-    const double m = kMarkerRadius + 1.0;
-    svg += "<defs><clipPath" + attr("id", "plot-clip") + "><rect" +
-           attr("x", px(left - m)) + attr("y", px(top - m)) +
-           attr("width", px(plot_w + 2.0 * m)) +
-           attr("height", px(plot_h + 2.0 * m)) + "/></clipPath></defs>\n";
-  }
-
+  const std::string d = std::to_string(chart.series.size()) + " series, " +
+                        std::to_string(p.points) + " points drawn. Dropped: " +
+                        std::to_string(p.non_finite) + " non-finite point(s), " +
+                        std::to_string(p.non_positive) +
+                        " non-positive point(s) on a log axis.";
+  svg += "<desc>" + escape(d + p.notes) + "</desc>\n";
+  svg += "<rect" + attr("x", "0") + attr("y", "0") + attr("width", px(l.W)) +
+         attr("height", px(l.H)) + attr("fill", "white") + "/>\n";
+  // the series are clipped to the plot area, widened by a marker so that a
+  // point on an axis limit shows whole
+  const double m = kMarkerRadius + 1.0;
+  svg += "<defs><clipPath" + attr("id", id + "plot-clip") + "><rect" +
+         attr("x", px(l.left - m)) + attr("y", px(l.top - m)) +
+         attr("width", px(l.plot_w + 2.0 * m)) +
+         attr("height", px(l.plot_h + 2.0 * m)) + "/></clipPath></defs>\n";
+  const double cx = l.left + 0.5 * l.plot_w;
   if (!chart.title.empty()) {
-    svg += "<text" + attr("class", "title") + attr("x", px(left + 0.5 * plot_w)) +
+    svg += "<text" + attr("class", "title") + attr("x", px(cx)) +
            attr("y", px(0.5 * kMarginTop + 4.0)) + attr("text-anchor", "middle") +
            attr("font-size", "14") + ">" + escape(chart.title) + "</text>\n";
   }
+  if (!chart.subtitle.empty()) {
+    svg += "<text" + attr("class", "subtitle") + attr("x", px(cx)) +
+           attr("y", px(0.5 * kMarginTop + 4.0 + kSubtitleRow + 1.0)) +
+           attr("text-anchor", "middle") + attr("fill", chart.subtitle_color) +
+           ">" + escape(chart.subtitle) + "</text>\n";
+  }
+  return svg;
+}
 
-  // grid and ticks
-  svg += "<g" + attr("class", "axes") + ">\n";
-  for (const Tick& t : chart.x.log ? log_ticks(x0, x1) : linear_ticks(x0, x1)) {
+// the bands, under everything else in the plot area
+std::string bands_svg(const Chart& chart, const Layout& l, const Scale& sx,
+                      const std::string& id) {
+  if (chart.bands.empty()) return "";
+  std::string svg = "<g" + attr("class", "bands") +
+                    attr("clip-path", "url(#" + id + "plot-clip)") + ">\n";
+  for (const ChartBand& b : chart.bands) {
+    if (!std::isfinite(b.x0) || !std::isfinite(b.x1)) continue;
+    if (sx.log && (b.x0 <= 0.0 || b.x1 <= 0.0)) continue;
+    const double a = sx.to_px(std::min(b.x0, b.x1));
+    const double z = sx.to_px(std::max(b.x0, b.x1));
+    // clamped to the plot area (the clip path is a marker wider)
+    const double from = std::clamp(a, l.left, l.left + l.plot_w);
+    const double to = std::clamp(z, l.left, l.left + l.plot_w);
+    svg += "<rect" + attr("x", px(from)) + attr("y", px(l.top)) +
+           attr("width", px(to - from)) + attr("height", px(l.plot_h)) +
+           attr("fill", b.color) + "/>\n";
+  }
+  return svg + "</g>\n";
+}
+
+// grid lines, ticks and their numbers along one axis
+std::string x_ticks_svg(const Chart& chart, const Prepared& p, const Layout& l,
+                        const Scale& sx) {
+  std::string svg;
+  for (const Tick& t : chart.x.log ? log_ticks(p.x0, p.x1) : linear_ticks(p.x0, p.x1)) {
     const double X = sx.to_px(t.value);
-    svg += "<line" + attr("x1", px(X)) + attr("y1", px(top)) +
-           attr("x2", px(X)) + attr("y2", px(bottom)) +
+    svg += "<line" + attr("x1", px(X)) + attr("y1", px(l.top)) +
+           attr("x2", px(X)) + attr("y2", px(l.bottom)) +
            attr("stroke", t.major ? "#dddddd" : "#f0f0f0") + "/>\n";
-    svg += "<line" + attr("x1", px(X)) + attr("y1", px(bottom)) +
-           attr("x2", px(X)) + attr("y2", px(bottom + (t.major ? 5.0 : 3.0))) +
+    svg += "<line" + attr("x1", px(X)) + attr("y1", px(l.bottom)) +
+           attr("x2", px(X)) + attr("y2", px(l.bottom + (t.major ? 5.0 : 3.0))) +
            attr("stroke", "#444") + "/>\n";
     if (t.major) {
       svg += "<text" + attr("class", "tick-label") + attr("x", px(X)) +
-             attr("y", px(bottom + 17.0)) + attr("text-anchor", "middle") +
+             attr("y", px(l.bottom + 17.0)) + attr("text-anchor", "middle") +
              ">" + tick_text(t.value, chart.x.log) + "</text>\n";
     }
   }
-  for (const Tick& t : chart.y.log ? log_ticks(y0, y1) : linear_ticks(y0, y1)) {
+  return svg;
+}
+
+std::string y_ticks_svg(const Chart& chart, const Prepared& p, const Layout& l,
+                        const Scale& sy) {
+  std::string svg;
+  for (const Tick& t : chart.y.log ? log_ticks(p.y0, p.y1) : linear_ticks(p.y0, p.y1)) {
     const double Y = sy.to_px(t.value);
-    svg += "<line" + attr("x1", px(left)) + attr("y1", px(Y)) +
-           attr("x2", px(left + plot_w)) + attr("y2", px(Y)) +
+    svg += "<line" + attr("x1", px(l.left)) + attr("y1", px(Y)) +
+           attr("x2", px(l.left + l.plot_w)) + attr("y2", px(Y)) +
            attr("stroke", t.major ? "#dddddd" : "#f0f0f0") + "/>\n";
-    svg += "<line" + attr("x1", px(left - (t.major ? 5.0 : 3.0))) +
-           attr("y1", px(Y)) + attr("x2", px(left)) + attr("y2", px(Y)) +
+    svg += "<line" + attr("x1", px(l.left - (t.major ? 5.0 : 3.0))) +
+           attr("y1", px(Y)) + attr("x2", px(l.left)) + attr("y2", px(Y)) +
            attr("stroke", "#444") + "/>\n";
     if (t.major) {
-      svg += "<text" + attr("class", "tick-label") + attr("x", px(left - 7.0)) +
+      svg += "<text" + attr("class", "tick-label") + attr("x", px(l.left - 7.0)) +
              attr("y", px(Y + 4.0)) + attr("text-anchor", "end") + ">" +
              tick_text(t.value, chart.y.log) + "</text>\n";
     }
   }
-  svg += "</g>\n";
-  // the plot area's frame: its x, y, width and height are the pixels of the
-  // axes' limits
-  svg += "<rect" + attr("class", "plot-area") + attr("x", px(left)) +
-         attr("y", px(top)) + attr("width", px(plot_w)) +
-         attr("height", px(plot_h)) + attr("fill", "none") +
-         attr("stroke", "#444") + "/>\n";
-  svg += "<text" + attr("class", "axis-label") + attr("id", "x-label") +
-         attr("x", px(left + 0.5 * plot_w)) + attr("y", px(bottom + 38.0)) +
-         attr("text-anchor", "middle") + ">" + escape(chart.x.label) +
-         "</text>\n";
-  {
-    const double lx = 18.0, ly = top + 0.5 * plot_h;
-    svg += "<text" + attr("class", "axis-label") + attr("id", "y-label") +
-           attr("x", px(lx)) + attr("y", px(ly)) +
-           attr("transform", "rotate(-90 " + px(lx) + " " + px(ly) + ")") +
-           attr("text-anchor", "middle") + ">" + escape(chart.y.label) +
-           "</text>\n";
-  }
-
-  // the series, clipped to the plot area
-  for (std::size_t i = 0; i < chart.series.size(); ++i) {
-    const ChartSeries& s = chart.series[i];
-    const Kept& k = kept[i];
-    svg += "<g" + attr("class", "series") +
-           attr("id", "series-" + std::to_string(i)) +
-           attr("clip-path", "url(#plot-clip)") + ">\n";
-    svg += "<desc>" +
-           escape(s.label + ": " + std::to_string(k.pts.size()) +
-                  " points drawn, " + std::to_string(k.non_finite) +
-                  " non-finite and " + std::to_string(k.non_positive) +
-                  " non-positive (log axis) dropped") +
-           "</desc>\n";
-    if (s.line && k.pts.size() >= 2) {
-      std::string p;
-      for (const auto& [x, y] : k.pts) {
-        if (!p.empty()) p += ' ';
-        p += px(sx.to_px(x)) + "," + px(sy.to_px(y));
-      }
-      svg += "<polyline" + attr("points", p) + attr("fill", "none") +
-             attr("stroke", colors[i]) + attr("stroke-width", "1.5") +
-             (s.dashed ? attr("stroke-dasharray", "6 4") : "") + "/>\n";
-    }
-    if (s.markers) {
-      for (const auto& [x, y] : k.pts) {
-        svg += "<circle" + attr("cx", px(sx.to_px(x))) +
-               attr("cy", px(sy.to_px(y))) + attr("r", px(kMarkerRadius)) +
-               attr("fill", colors[i]) + "/>\n";
-      }
-    }
-    svg += "</g>\n";
-  }
-
-  // the legend
-  if (legend_rows > 0) {
-    const double lx = left + plot_w + kLegendGap;
-    double ly = top + 8.0;
-    svg += "<g" + attr("class", "legend") + ">\n";
-    for (std::size_t i = 0; i < chart.series.size(); ++i) {
-      const ChartSeries& s = chart.series[i];
-      if (s.label.empty()) continue;
-      if (s.line) {
-        svg += "<line" + attr("x1", px(lx)) + attr("y1", px(ly)) +
-               attr("x2", px(lx + kLegendSample)) + attr("y2", px(ly)) +
-               attr("stroke", colors[i]) + attr("stroke-width", "1.5") +
-               (s.dashed ? attr("stroke-dasharray", "6 4") : "") + "/>\n";
-      }
-      if (s.markers) {
-        // a rounded square that looks like the markers: a <circle> here
-        // would count as one of the series' markers to a reader of the file
-        const double r = kMarkerRadius;
-        svg += "<rect" + attr("x", px(lx + 0.5 * kLegendSample - r)) +
-               attr("y", px(ly - r)) + attr("width", px(2.0 * r)) +
-               attr("height", px(2.0 * r)) + attr("rx", px(r)) +
-               attr("fill", colors[i]) + "/>\n";
-      }
-      svg += "<text" + attr("x", px(lx + kLegendSample + 6.0)) +
-             attr("y", px(ly + 4.0)) + ">" + escape(s.label) + "</text>\n";
-      ly += kLegendRow;
-    }
-    svg += "</g>\n";
-  }
-
-  svg += "</svg>\n";
   return svg;
 }
 
-}  // namespace vmh::sim
+// the plot area's frame (its x, y, width and height are the pixels of the
+// axes' limits) and the axis labels
+std::string frame_svg(const Chart& chart, const Layout& l, const std::string& id) {
+  std::string svg = "<rect" + attr("class", "plot-area") + attr("x", px(l.left)) +
+                    attr("y", px(l.top)) + attr("width", px(l.plot_w)) +
+                    attr("height", px(l.plot_h)) + attr("fill", "none") +
+                    attr("stroke", "#444") + "/>\n";
+  svg += "<text" + attr("class", "axis-label") + attr("id", id + "x-label") +
+         attr("x", px(l.left + 0.5 * l.plot_w)) + attr("y", px(l.bottom + 38.0)) +
+         attr("text-anchor", "middle") + ">" + escape(chart.x.label) +
+         "</text>\n";
+  const double lx = 18.0, ly = l.top + 0.5 * l.plot_h;
+  svg += "<text" + attr("class", "axis-label") + attr("id", id + "y-label") +
+         attr("x", px(lx)) + attr("y", px(ly)) +
+         attr("transform", "rotate(-90 " + px(lx) + " " + px(ly) + ")") +
+         attr("text-anchor", "middle") + ">" + escape(chart.y.label) +
+         "</text>\n";
+  return svg;
+}
+
+// one series, clipped to the plot area
+std::string series_svg(const ChartSeries& s, const Kept& k,
+                       const std::string& color, const Scale& sx,
+                       const Scale& sy, const std::string& id, std::size_t i) {
+  std::string svg = "<g" + attr("class", "series") +
+                    attr("id", id + "series-" + std::to_string(i)) +
+                    attr("clip-path", "url(#" + id + "plot-clip)") + ">\n";
+  svg += "<desc>" +
+         escape(s.label + ": " + std::to_string(k.pts.size()) +
+                " points drawn, " + std::to_string(k.non_finite) +
+                " non-finite and " + std::to_string(k.non_positive) +
+                " non-positive (log axis) dropped") +
+         "</desc>\n";
+  if (s.line && k.pts.size() >= 2) {
+    std::string p;
+    for (const auto& [x, y] : k.pts) {
+      if (!p.empty()) p += ' ';
+      p += px(sx.to_px(x)) + "," + px(sy.to_px(y));
+    }
+    svg += "<polyline" + attr("points", p) + attr("fill", "none") +
+           attr("stroke", color) + attr("stroke-width", "1.5") +
+           (s.dashed ? attr("stroke-dasharray", "6 4") : "") + "/>\n";
+  }
+  if (s.markers) {
+    for (const auto& [x, y] : k.pts) {
+      svg += "<circle" + attr("cx", px(sx.to_px(x))) +
+             attr("cy", px(sy.to_px(y))) + attr("r", px(kMarkerRadius)) +
+             attr("fill", color) + "/>\n";
+    }
+  }
+  return svg + "</g>\n";
+}
+
+// the legend: a sample of each labelled series' line and marker, and its label
+std::string legend_svg(const Chart& chart, const Prepared& p, const Layout& l) {
+  if (l.legend_rows == 0) return "";
+  const double lx = l.left + l.plot_w + kLegendGap;
+  double ly = l.top + 8.0;
+  std::string svg = "<g" + attr("class", "legend") + ">\n";
+  for (std::size_t i = 0; i < chart.series.size(); ++i) {
+    const ChartSeries& s = chart.series[i];
+    if (s.label.empty()) continue;
+    if (s.line) {
+      svg += "<line" + attr("x1", px(lx)) + attr("y1", px(ly)) +
+             attr("x2", px(lx + kLegendSample)) + attr("y2", px(ly)) +
+             attr("stroke", p.colors[i]) + attr("stroke-width", "1.5") +
+             (s.dashed ? attr("stroke-dasharray", "6 4") : "") + "/>\n";
+    }
+    if (s.markers) {
+      // a rounded square that looks like the markers: a <circle> here would
+      // count as one of the series' markers to a reader of the file
+      const double r = kMarkerRadius;
+      svg += "<rect" + attr("x", px(lx + 0.5 * kLegendSample - r)) +
+             attr("y", px(ly - r)) + attr("width", px(2.0 * r)) +
+             attr("height", px(2.0 * r)) + attr("rx", px(r)) +
+             attr("fill", p.colors[i]) + "/>\n";
+    }
+    svg += "<text" + attr("x", px(lx + kLegendSample + 6.0)) +
+           attr("y", px(ly + 4.0)) + ">" + escape(s.label) + "</text>\n";
+    ly += kLegendRow;
+  }
+  return svg + "</g>\n";
+}
+
+// Everything inside the chart's <svg> element; element ids start with `id`.
+std::string chart_body(const Chart& chart, const std::string& id) {
+  const Prepared p = prepare(chart);
+  const Layout l = layout(chart);
+  const Scale sx{chart.x.log, p.x0, p.x1, l.left, l.left + l.plot_w};
+  const Scale sy{chart.y.log, p.y0, p.y1, l.bottom, l.top};  // y up
+  std::string svg = head_svg(chart, p, l, id);
+  svg += bands_svg(chart, l, sx, id);
+  svg += "<g" + attr("class", "axes") + ">\n" + x_ticks_svg(chart, p, l, sx) +
+         y_ticks_svg(chart, p, l, sy) + "</g>\n";
+  svg += frame_svg(chart, l, id);
+  for (std::size_t i = 0; i < chart.series.size(); ++i) {
+    svg += series_svg(chart.series[i], p.kept[i], p.colors[i], sx, sy, id, i);
+  }
+  return svg + legend_svg(chart, p, l);
+}
+
+// the <svg> element's size and font
+std::string size_attrs(double W, double H) {
+  return attr("width", px(W)) + attr("height", px(H)) +
+         attr("viewBox", "0 0 " + px(W) + " " + px(H)) +
+         " font-family=\"sans-serif\" font-size=\"11\"";
+}
+
+}  // namespace
+
+std::string chart_svg(const Chart& chart) {
+  check_lengths(chart, "chart_svg");
+  const double W = std::max(chart.width_px, 1);
+  const double H = std::max(chart.height_px, 1);
+  return "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\"" +
+         attr("class", "chart") + size_attrs(W, H) + ">\n" +
+         chart_body(chart, "") + "</svg>\n";
+}
+
+std::string chart_grid_svg(const ChartGrid& grid) {
+  int cell_w = 1, cell_h = 1;
+  for (std::size_t k = 0; k < grid.panels.size(); ++k) {
+    check_lengths(grid.panels[k], "chart_grid_svg: panel " + std::to_string(k));
+    cell_w = std::max(cell_w, grid.panels[k].width_px);
+    cell_h = std::max(cell_h, grid.panels[k].height_px);
+  }
+  const std::size_t cols = static_cast<std::size_t>(std::max(grid.columns, 1));
+  const std::size_t rows = (grid.panels.size() + cols - 1) / cols;
+  // the title's row, a row per note, and a gap
+  const double head = (grid.title.empty() ? 0.0 : 30.0) +
+                      18.0 * static_cast<double>(grid.notes.size()) + 6.0;
+  const double W = static_cast<double>(cols) * cell_w;
+  const double H = head + static_cast<double>(rows) * cell_h + 10.0;
+  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\"" +
+                    attr("class", "chart-grid") + size_attrs(W, H) + ">\n";
+  if (!grid.title.empty()) svg += "<title>" + escape(grid.title) + "</title>\n";
+  svg += "<rect" + attr("width", px(W)) + attr("height", px(H)) +
+         attr("fill", "white") + "/>\n";
+  double y = 0.0;
+  if (!grid.title.empty()) {
+    y += 24.0;
+    svg += "<text" + attr("class", "title") + attr("x", "10") + attr("y", px(y)) +
+           attr("font-size", "15") + ">" + escape(grid.title) + "</text>\n";
+  }
+  for (const std::string& note : grid.notes) {
+    y += 18.0;
+    svg += "<text" + attr("class", "note") + attr("x", "10") + attr("y", px(y)) +
+           attr("fill", "#555") + ">" + escape(note) + "</text>\n";
+  }
+  for (std::size_t k = 0; k < grid.panels.size(); ++k) {
+    const Chart& c = grid.panels[k];
+    const std::string id = "panel-" + std::to_string(k);
+    svg += "<svg" + attr("class", "chart") + attr("id", id) +
+           attr("x", px(static_cast<double>(k % cols) * cell_w)) +
+           attr("y", px(head + static_cast<double>(k / cols) * cell_h)) +
+           size_attrs(std::max(c.width_px, 1), std::max(c.height_px, 1)) +
+           ">\n" + chart_body(c, id + "-") + "</svg>\n";
+  }
+  return svg + "</svg>\n";
+}
+
+}  // namespace vmh::report

@@ -11,6 +11,10 @@
 // each series a <g class="series" id="series-N"> (N from 0, in order) holding
 // a <polyline> and/or <circle> markers whose coordinates are pixels, and
 // each axis label a <text class="axis-label">.
+//
+// Several charts can share one document as panels of a grid (ChartGrid):
+// each panel is a nested <svg class="chart" id="panel-K"> whose element ids
+// start with "panel-K-" (so "panel-K-series-N").
 #ifndef VMHAPTICS_REPORT_SVG_CHART_H_
 #define VMHAPTICS_REPORT_SVG_CHART_H_
 
@@ -18,7 +22,7 @@
 #include <string>
 #include <vector>
 
-namespace vmh::sim {
+namespace vmh::report {
 
 struct ChartSeries {
   std::string label;        // legend text
@@ -37,11 +41,24 @@ struct ChartAxis {
   double max = std::nan("");
 };
 
+// A shaded interval of x over the plot area's whole height, drawn under the
+// grid and the series (e.g. the time window a study judges).
+struct ChartBand {
+  double x0 = 0.0;  // data units, either order
+  double x1 = 0.0;
+  std::string color = "#e0e0e0";
+};
+
 struct Chart {
   std::string title;
+  // a second line under the title, smaller and in its own colour (e.g. an
+  // outcome); empty: none, and the title's margin stays as it was
+  std::string subtitle;
+  std::string subtitle_color = "#555555";
   ChartAxis x;
   ChartAxis y;
   std::vector<ChartSeries> series;
+  std::vector<ChartBand> bands;
   int width_px = 640;
   int height_px = 420;
 };
@@ -50,6 +67,19 @@ struct Chart {
 // x and y of different lengths.
 std::string chart_svg(const Chart& chart);
 
-}  // namespace vmh::sim
+// Charts side by side, `columns` to a row in order, each in a cell as large
+// as the largest panel, under a title and lines of notes.
+struct ChartGrid {
+  std::string title;
+  std::vector<std::string> notes;
+  int columns = 1;
+  std::vector<Chart> panels;
+};
+
+// The grid as one SVG document (<svg class="chart-grid">). Throws
+// std::invalid_argument as chart_svg does, naming the panel.
+std::string chart_grid_svg(const ChartGrid& grid);
+
+}  // namespace vmh::report
 
 #endif  // VMHAPTICS_REPORT_SVG_CHART_H_

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <string>
 
-namespace vmh::sim::svg {
+namespace vmh::report::svg {
 
 // one number through printf's format f
 inline std::string format(const char* f, double v) {
@@ -58,6 +58,6 @@ inline double nice_step(double span, double ticks) {
   return 10.0 * mag;
 }
 
-}  // namespace vmh::sim::svg
+}  // namespace vmh::report::svg
 
 #endif  // VMHAPTICS_REPORT_SVG_TEXT_H_

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <set>
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
 constexpr double kRadToDeg = 57.295779513082320876798;
@@ -164,72 +166,70 @@ std::vector<Claim> evaluate_claims(int thesis_case,
 
 namespace {
 
-std::vector<Claim> measure_claims(int thesis_case,
-                                  const std::vector<TraceRow>& rows,
-                                  const ClosedLoop& loop) {
-  std::vector<Claim> claims;
-  if (thesis_case < 1 || thesis_case > 6) return claims;
-  const HandScript& script = loop.script();
-  const ControllerParams& p = loop.controller_params();
+// Cases 1 and 5, position error only: no force on the path, off it a force
+// toward X(theta_V), and none from X(theta_R).
+void position_claims(const std::vector<TraceRow>& rows, const HandScript& script,
+                     const ControllerParams& p, std::vector<Claim>* claims_out) {
+  std::vector<Claim>& claims = *claims_out;
   const std::set<std::string> off = {"off_out", "off_out_misaligned", "off_in"};
+  const std::set<std::string> on = {"on_misaligned_a", "on_misaligned_b"};
+  {
+    const auto w = settled(rows, script, on);
+    std::vector<double> f;
+    for (const TraceRow* r : w) f.push_back(r->out.force_device_N.norm());
+    claims.push_back(make(
+        "on_path_no_force",
+        "with the RM on the path there is no force (the stylus misaligned)",
+        on, mean_of(f), "<=", 0.05, "N", static_cast<int>(w.size())));
+  }
+  {
+    // measured against the ground truth: the true wrist centre and the
+    // closed-form nearest point of the path, not the controller's own
+    // (quantised, Gauss-Newton) X(theta_V)
+    const auto w = settled(rows, script, off);
+    double worst = 0.0;
+    int n = 0;
+    for (const TraceRow* r : w) {
+      const double a =
+          angle_deg(r->out.force_device_N, r->nearest_true_mm - r->p_true_mm);
+      if (std::isfinite(a)) {
+        worst = std::max(worst, a);
+        ++n;
+      }
+    }
+    claims.push_back(make(
+        "off_path_force_toward_xv",
+        "off the path the force is normal to it and pulls toward X(theta_V) "
+        "(max angle from the true nearest point)",
+        off, n > 0 ? worst : std::nan(""), "<=", 2.0, "deg", n));
+  }
+  {
+    // the force compared with what the same gain would give on the error
+    // to X(theta_R): "independent of X(theta_R)"
+    const auto w = settled(rows, script, on);
+    std::vector<double> f, xr;
+    for (const TraceRow* r : w) {
+      f.push_back(r->out.force_device_N.norm());
+      xr.push_back((r->out.x_r_mm - r->out.p_rm_mm).norm());
+    }
+    const double ratio =
+        mean_of(f) / (p.gains.k_pos_N_per_mm * std::max(mean_of(xr), 1e-9));
+    claims.push_back(make(
+        "force_independent_of_xr",
+        "the force does not depend on X(theta_R): |F| / (K_pos |X(theta_R) "
+        "- p|) on the path",
+        on, ratio, "<=", 0.02, "-", static_cast<int>(w.size())));
+  }
+}
+
+// Cases 2, 3, 4 and 6, position and orientation: off the path the force
+// points between X(theta_V) and X(theta_R), on it toward X(theta_R), felt.
+void orientation_claims(const std::vector<TraceRow>& rows,
+                        const HandScript& script,
+                        std::vector<Claim>* claims_out) {
+  std::vector<Claim>& claims = *claims_out;
   const std::set<std::string> off_mis = {"off_out_misaligned"};
   const std::set<std::string> on = {"on_misaligned_a", "on_misaligned_b"};
-  const std::set<std::string> sweep = {"sweep"};
-  const bool orientation = p.gains.k_ornt_Nmm_per_rad > 0.0;
-
-  if (!orientation) {
-    // cases 1 and 5: position error only
-    {
-      const auto w = settled(rows, script, on);
-      std::vector<double> f;
-      for (const TraceRow* r : w) f.push_back(r->out.force_device_N.norm());
-      claims.push_back(make(
-          "on_path_no_force",
-          "with the RM on the path there is no force (the stylus misaligned)",
-          on, mean_of(f), "<=", 0.05, "N", static_cast<int>(w.size())));
-    }
-    {
-      // measured against the ground truth: the true wrist centre and the
-      // closed-form nearest point of the path, not the controller's own
-      // (quantised, Gauss-Newton) X(theta_V)
-      const auto w = settled(rows, script, off);
-      double worst = 0.0;
-      int n = 0;
-      for (const TraceRow* r : w) {
-        const double a =
-            angle_deg(r->out.force_device_N, r->nearest_true_mm - r->p_true_mm);
-        if (std::isfinite(a)) {
-          worst = std::max(worst, a);
-          ++n;
-        }
-      }
-      claims.push_back(make(
-          "off_path_force_toward_xv",
-          "off the path the force is normal to it and pulls toward X(theta_V) "
-          "(max angle from the true nearest point)",
-          off, n > 0 ? worst : std::nan(""), "<=", 2.0, "deg", n));
-    }
-    {
-      // the force compared with what the same gain would give on the error
-      // to X(theta_R): "independent of X(theta_R)"
-      const auto w = settled(rows, script, on);
-      std::vector<double> f, xr;
-      for (const TraceRow* r : w) {
-        f.push_back(r->out.force_device_N.norm());
-        xr.push_back((r->out.x_r_mm - r->out.p_rm_mm).norm());
-      }
-      const double ratio =
-          mean_of(f) / (p.gains.k_pos_N_per_mm * std::max(mean_of(xr), 1e-9));
-      claims.push_back(make(
-          "force_independent_of_xr",
-          "the force does not depend on X(theta_R): |F| / (K_pos |X(theta_R) "
-          "- p|) on the path",
-          on, ratio, "<=", 0.02, "-", static_cast<int>(w.size())));
-    }
-    return claims;
-  }
-
-  // cases 2, 3, 4, 6: position and orientation
   {
     const auto w = settled(rows, script, off_mis);
     int good = 0, n = 0;
@@ -272,68 +272,98 @@ std::vector<Claim> measure_claims(int thesis_case,
                           "on the path the orientation error is felt: mean |F|",
                           on, mean_of(f), ">=", 0.1, "N", n));
   }
-  if (p.vm.kind == VmKind::kCircle) {
-    // case 2's "bending feel": along the path, not across it
-    const auto w = settled(rows, script, on);
-    std::vector<double> a;
-    for (const TraceRow* r : w) {
-      const double x =
-          angle_deg(r->out.force_device_N, along_path_toward_xr(*r, p));
-      if (std::isfinite(x)) a.push_back(x);
-    }
-    claims.push_back(make(
-        "on_path_force_along_path",
-        "on the path the force runs along the path toward X(theta_R), a "
-        "bending feel: mean angle from the path's tangent",
-        on, mean_of(a), "<=", 25.0, "deg", static_cast<int>(a.size())));
+}
+
+// Case 2's "bending feel" on a circle: along the path, not across it.
+void along_path_claim(const std::vector<TraceRow>& rows, const HandScript& script,
+                      const ControllerParams& p, std::vector<Claim>* claims) {
+  const std::set<std::string> on = {"on_misaligned_a", "on_misaligned_b"};
+  const auto w = settled(rows, script, on);
+  std::vector<double> a;
+  for (const TraceRow* r : w) {
+    const double x =
+        angle_deg(r->out.force_device_N, along_path_toward_xr(*r, p));
+    if (std::isfinite(x)) a.push_back(x);
   }
+  claims->push_back(make(
+      "on_path_force_along_path",
+      "on the path the force runs along the path toward X(theta_R), a "
+      "bending feel: mean angle from the path's tangent",
+      on, mean_of(a), "<=", 25.0, "deg", static_cast<int>(a.size())));
+}
+
+// Cases 3 and 4: position (3) or orientation (4) weighs more than in case 2,
+// the same readings through case 2's gains.
+void weighting_claim(int thesis_case, const std::vector<TraceRow>& rows,
+                     const HandScript& script, std::vector<Claim>* claims) {
+  const std::set<std::string> off_mis = {"off_out_misaligned"};
+  const auto w = settled(rows, script, off_mis);
+  std::vector<double> mine, ref;
+  for (const TraceRow* r : w) {
+    const Vec3 dv = r->out.x_v_mm - r->out.p_rm_mm;
+    const double a = angle_deg(r->out.force_device_N, dv);
+    const double b = angle_deg(r->force_reference_N, dv);
+    if (std::isfinite(a) && std::isfinite(b)) {
+      mine.push_back(a);
+      ref.push_back(b);
+    }
+  }
+  const double ratio = mean_of(mine) / mean_of(ref);
+  if (thesis_case == 3) {
+    claims->push_back(make(
+        "position_weighs_more_than_case2",
+        "position error weighs more than in case 2: the force's angle from "
+        "X(theta_V) over case 2's at the same readings",
+        off_mis, ratio, "<=", 0.95, "-", static_cast<int>(mine.size())));
+  } else {
+    claims->push_back(make(
+        "orientation_weighs_more_than_case2",
+        "orientation error weighs more than in case 2: the force's angle "
+        "from X(theta_V) over case 2's at the same readings",
+        off_mis, ratio, ">=", 1.05, "-", static_cast<int>(mine.size())));
+  }
+}
+
+// Case 4 (Fig. 4.12): farther from the path the force is much greater than
+// on it.
+void force_grows_claim(const std::vector<TraceRow>& rows,
+                       const HandScript& script, std::vector<Claim>* claims) {
+  const std::set<std::string> sweep = {"sweep"};
+  std::vector<double> far, near;
+  for (const TraceRow& r : rows) {
+    if (script.segments()[static_cast<std::size_t>(r.segment)].name != "sweep")
+      continue;
+    const double f = r.out.force_device_N.norm();
+    if (r.d_path_mm >= 5.0) far.push_back(f);
+    if (r.d_path_mm <= kOnPathMm) near.push_back(f);
+  }
+  claims->push_back(make(
+      "force_grows_off_path",
+      "farther from the path the force is much greater than on it: mean "
+      "|F| at >= 5 mm over mean |F| within 1 mm, during the sweep",
+      sweep, mean_of(far) / std::max(mean_of(near), 1e-9), ">=", 3.0, "-",
+      static_cast<int>(std::min(far.size(), near.size()))));
+}
+
+std::vector<Claim> measure_claims(int thesis_case,
+                                  const std::vector<TraceRow>& rows,
+                                  const ClosedLoop& loop) {
+  std::vector<Claim> claims;
+  if (thesis_case < 1 || thesis_case > 6) return claims;
+  const HandScript& script = loop.script();
+  const ControllerParams& p = loop.controller_params();
+  if (!(p.gains.k_ornt_Nmm_per_rad > 0.0)) {  // cases 1 and 5
+    position_claims(rows, script, p, &claims);
+    return claims;
+  }
+  orientation_claims(rows, script, &claims);
+  if (p.vm.kind == VmKind::kCircle) along_path_claim(rows, script, p, &claims);
   if (thesis_case == 3 || thesis_case == 4) {
-    // the same readings through case 2's gains
-    const auto w = settled(rows, script, off_mis);
-    std::vector<double> mine, ref;
-    for (const TraceRow* r : w) {
-      const Vec3 dv = r->out.x_v_mm - r->out.p_rm_mm;
-      const double a = angle_deg(r->out.force_device_N, dv);
-      const double b = angle_deg(r->force_reference_N, dv);
-      if (std::isfinite(a) && std::isfinite(b)) {
-        mine.push_back(a);
-        ref.push_back(b);
-      }
-    }
-    const double ratio = mean_of(mine) / mean_of(ref);
-    if (thesis_case == 3) {
-      claims.push_back(make(
-          "position_weighs_more_than_case2",
-          "position error weighs more than in case 2: the force's angle from "
-          "X(theta_V) over case 2's at the same readings",
-          off_mis, ratio, "<=", 0.95, "-", static_cast<int>(mine.size())));
-    } else {
-      claims.push_back(make(
-          "orientation_weighs_more_than_case2",
-          "orientation error weighs more than in case 2: the force's angle "
-          "from X(theta_V) over case 2's at the same readings",
-          off_mis, ratio, ">=", 1.05, "-", static_cast<int>(mine.size())));
-    }
+    weighting_claim(thesis_case, rows, script, &claims);
   }
-  if (thesis_case == 4) {
-    // Fig. 4.12: farther from the path the force is much greater than on it
-    std::vector<double> far, near;
-    for (const TraceRow& r : rows) {
-      if (script.segments()[static_cast<std::size_t>(r.segment)].name != "sweep")
-        continue;
-      const double f = r.out.force_device_N.norm();
-      if (r.d_path_mm >= 5.0) far.push_back(f);
-      if (r.d_path_mm <= kOnPathMm) near.push_back(f);
-    }
-    claims.push_back(make(
-        "force_grows_off_path",
-        "farther from the path the force is much greater than on it: mean "
-        "|F| at >= 5 mm over mean |F| within 1 mm, during the sweep",
-        sweep, mean_of(far) / std::max(mean_of(near), 1e-9), ">=", 3.0, "-",
-        static_cast<int>(std::min(far.size(), near.size()))));
-  }
+  if (thesis_case == 4) force_grows_claim(rows, script, &claims);
   return claims;
 }
 
 }  // namespace
-}  // namespace vmh::sim
+}  // namespace vmh::studies

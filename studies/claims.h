@@ -14,7 +14,7 @@
 
 #include "sim/closed_loop.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 struct Claim {
   std::string name;
@@ -52,8 +52,8 @@ struct RunMetrics {
 // within this distance (mm) the RM counts as on the path for time_on_path_s
 inline constexpr double kOnPathMm = 1.0;
 
-RunMetrics run_metrics(const std::vector<TraceRow>& rows,
-                       const ClosedLoop& loop);
+RunMetrics run_metrics(const std::vector<sim::TraceRow>& rows,
+                       const sim::ClosedLoop& loop);
 
 // The gains a case's claims compare against (case 2's for cases 3 and 4),
 // if any.
@@ -62,9 +62,9 @@ std::optional<ControllerParams> reference_params(int thesis_case,
 
 // The claims of thesis case 1..6 measured on `rows` (empty for 0).
 std::vector<Claim> evaluate_claims(int thesis_case,
-                                   const std::vector<TraceRow>& rows,
-                                   const ClosedLoop& loop);
+                                   const std::vector<sim::TraceRow>& rows,
+                                   const sim::ClosedLoop& loop);
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_CLAIMS_H_

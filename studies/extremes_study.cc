@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -15,7 +14,9 @@
 #include "report/parallel.h"
 #include "studies/run_case.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace fs = std::filesystem;
 namespace {
 
@@ -194,169 +195,204 @@ std::vector<ExtremeScenario> extreme_scenarios() {
   return s;
 }
 
-ExtremeResult run_extreme(const ExtremeScenario& s,
-                          std::vector<TraceRow>* trace) {
-  ExtremeResult r;
-  r.scenario = s;
-  std::string name;
-  const std::string scene = resolve_scene(s.base, &name);
-  std::vector<std::string> sets = {"duration_s=" + std::to_string(kExtremeDurationS)};
-  sets.insert(sets.end(), s.overrides.begin(), s.overrides.end());
-  ClosedLoop loop(scene, sets);
 
+namespace {
+
+// The force limit and the motors' torque clamps (ctrlrange of m1..m3).
+void read_limits(const ClosedLoop& loop, ExtremeResult* r) {
   const mjModel* m = loop.model();
-  const ControllerParams& params = loop.controller_params();
-  const OmniParams& omni = params.omni;
-  r.force_limit_N = params.force_limit_N;
+  r->force_limit_N = loop.controller_params().force_limit_N;
   for (int i = 0; i < 3; ++i) {
     const int a = mj_name2id(m, mjOBJ_ACTUATOR, ("m" + std::to_string(i + 1)).c_str());
-    r.motor_limit_Nm[i] = m->actuator_ctrlrange[2 * a + 1];
+    r->motor_limit_Nm[i] = m->actuator_ctrlrange[2 * a + 1];
   }
-  const Vec3 shoulder_mm = base_to_device_mm(omni, Vec3::Zero());
-  const double reach_mm = 1000.0 * (omni.l1_m + omni.l2_m);
-  const double script_end_s = loop.config().sim.duration_s;
-  const double end_s = script_end_s + kExtremeRestS;
+}
 
-  std::vector<TraceRow> local;
-  std::vector<TraceRow>& rows = trace != nullptr ? *trace : local;
-  rows.clear();
-  rows.reserve(static_cast<std::size_t>(loop.ticks_per_run()));
-
+// Ticks the loop until end_s, a row per tick; the wall time and the ticks
+// go in r.
+void run_ticks(ClosedLoop* loop, double end_s, std::vector<TraceRow>* rows,
+               ExtremeResult* r) {
+  const mjModel* m = loop->model();
+  rows->clear();
+  rows->reserve(static_cast<std::size_t>(loop->ticks_per_run()));
   const auto start = std::chrono::steady_clock::now();
-  while (loop.time_s() < end_s - 0.5 * m->opt.timestep) {
-    rows.emplace_back();
-    loop.tick(&rows.back());
+  while (loop->time_s() < end_s - 0.5 * m->opt.timestep) {
+    rows->emplace_back();
+    loop->tick(&rows->back());
   }
-  r.wall_time_s =
+  r->wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.simulated_s = loop.time_s();
-  r.ticks = static_cast<int>(rows.size());
+  r->simulated_s = loop->time_s();
+  r->ticks = static_cast<int>(rows->size());
+}
 
-  // -- per tick --
-  std::set<std::string> statuses, device_errors, guard_faults;
-  ControlStatus seen = kStatusOk;
-  r.energy_motor_max_J = r.energy_motor_min_J = 0.0;
-  r.min_pivot_distance_mm = 1e300;
-  r.min_q5_to_singular_rad = 1e300;
-  r.min_period_s = 1e300;
-  double period_sum = 0.0;
-  // the rest's last window
-  const double window_from_s = end_s - kRestWindowS;
-  bool in_window = false;
-  double window_start_J = 0.0;
-  double prev_end_J = 0.0;  // the observer at the end of the last tick
-  r.min_pole_angle_rad = 1e300;
-  const Vec3 pole_axis = params.vm.R_pivot.col(2);
-  for (std::size_t k = 0; k < rows.size(); ++k) {
+// What every tick adds to the result: the four counts' raw material, and
+// what the scenario reached.
+class TickScan {
+ public:
+  TickScan(const ClosedLoop& loop, double end_s, ExtremeResult* r)
+      : params_(loop.controller_params()),
+        r_(r),
+        shoulder_mm_(base_to_device_mm(params_.omni, Vec3::Zero())),
+        reach_mm_(1000.0 * (params_.omni.l1_m + params_.omni.l2_m)),
+        window_from_s_(end_s - kRestWindowS),
+        pole_axis_(params_.vm.R_pivot.col(2)) {
+    r_->energy_motor_max_J = r_->energy_motor_min_J = 0.0;
+    r_->min_pivot_distance_mm = 1e300;
+    r_->min_q5_to_singular_rad = 1e300;
+    r_->min_period_s = 1e300;
+    r_->min_pole_angle_rad = 1e300;
+  }
+
+  void add(const std::vector<TraceRow>& rows, std::size_t k) {
     const TraceRow& row = rows[k];
-    const int tick = static_cast<int>(k);
-    if (r.finite) {
+    finite(row);
+    command(row);
+    statuses(row, static_cast<int>(k));
+    energy(row);
+    reached(row, k > 0 ? &rows[k - 1] : nullptr);
+  }
+
+  // the mean period, and the names seen, sorted
+  void finish(std::size_t ticks) {
+    r_->mean_period_s = ticks == 0 ? 0.0 : period_sum_ / static_cast<double>(ticks);
+    for (int b = 0; b < kStatusFlagCount; ++b) {
+      if (seen_ & (1u << b)) statuses_.insert(status_flag_name(1u << b));
+    }
+    r_->statuses.assign(statuses_.begin(), statuses_.end());
+    r_->device_errors.assign(device_errors_.begin(), device_errors_.end());
+    r_->guard_faults.assign(guard_faults_.begin(), guard_faults_.end());
+  }
+
+  // whether the rest's last window was reached
+  bool in_window() const { return in_window_; }
+
+ private:
+  void finite(const TraceRow& row) {
+    if (r_->finite) {
       if (const char* part = nonfinite_part(row)) {
-        r.finite = false;
+        r_->finite = false;
         char buf[96];
         std::snprintf(buf, sizeof buf, "%s at t = %.4f s", part, row.t_s);
-        r.first_nonfinite = buf;
+        r_->first_nonfinite = buf;
       }
     }
-    if (!row.q_dh.allFinite()) ++r.nonfinite_reading_ticks;
+    if (!row.q_dh.allFinite()) ++r_->nonfinite_reading_ticks;
+  }
 
-    // the command as the controller computed it and as the motors held it
-    r.max_force_N = std::max(r.max_force_N, row.out.force_device_N.norm());
+  // the command as the controller computed it and as the motors held it
+  void command(const TraceRow& row) {
+    r_->max_force_N = std::max(r_->max_force_N, row.out.force_device_N.norm());
     for (int i = 0; i < 3; ++i) {
-      r.max_motor_torque_Nm[i] =
-          std::max(r.max_motor_torque_Nm[i], std::abs(row.motor_torque_Nm[i]));
+      r_->max_motor_torque_Nm[i] =
+          std::max(r_->max_motor_torque_Nm[i], std::abs(row.motor_torque_Nm[i]));
     }
+  }
 
-    // statuses
-    if (row.servo.read == DeviceError::kOk) seen |= row.out.status;
-    if (row.servo.read != DeviceError::kOk) device_errors.insert(device_error_name(row.servo.read));
-    if (row.servo.write != DeviceError::kOk) device_errors.insert(device_error_name(row.servo.write));
-    if (row.guard != GuardFault::kNone) guard_faults.insert(guard_fault_name(row.guard));
-    if (row.servo.zeroed) ++r.zeroed_ticks;
+  void statuses(const TraceRow& row, int tick) {
+    if (row.servo.read == DeviceError::kOk) seen_ |= row.out.status;
+    if (row.servo.read != DeviceError::kOk) device_errors_.insert(device_error_name(row.servo.read));
+    if (row.servo.write != DeviceError::kOk) device_errors_.insert(device_error_name(row.servo.write));
+    if (row.guard != GuardFault::kNone) guard_faults_.insert(guard_fault_name(row.guard));
+    if (row.servo.zeroed) ++r_->zeroed_ticks;
     const bool fault_named = row.servo.read != DeviceError::kOk ||
                              (row.servo.read == DeviceError::kOk && is_fault(row.out.status));
-    if (row.fault_injected && r.fault_tick < 0) r.fault_tick = tick;
-    if (r.fault_tick >= 0 && r.detection_tick < 0 && fault_named) r.detection_tick = tick;
-    if (r.detection_tick >= 0 && tick >= r.detection_tick) {
-      r.max_torque_after_detection_Nm =
-          std::max(r.max_torque_after_detection_Nm, row.motor_torque_Nm.cwiseAbs().maxCoeff());
+    if (row.fault_injected && r_->fault_tick < 0) r_->fault_tick = tick;
+    if (r_->fault_tick >= 0 && r_->detection_tick < 0 && fault_named) r_->detection_tick = tick;
+    if (r_->detection_tick >= 0 && tick >= r_->detection_tick) {
+      r_->max_torque_after_detection_Nm =
+          std::max(r_->max_torque_after_detection_Nm, row.motor_torque_Nm.cwiseAbs().maxCoeff());
     }
+  }
 
-    // energy
+  void energy(const TraceRow& row) {
     const double E = row.energy_motor_J;
-    r.energy_motor_max_J = std::max(r.energy_motor_max_J, E);
-    r.energy_motor_min_J = std::min(r.energy_motor_min_J, E);
-    r.kinetic_max_J = std::max(r.kinetic_max_J, row.kinetic_J);
-    if (row.t_s >= window_from_s) {
-      if (!in_window) {
-        in_window = true;
-        window_start_J = prev_end_J;
+    r_->energy_motor_max_J = std::max(r_->energy_motor_max_J, E);
+    r_->energy_motor_min_J = std::min(r_->energy_motor_min_J, E);
+    r_->kinetic_max_J = std::max(r_->kinetic_max_J, row.kinetic_J);
+    if (row.t_s >= window_from_s_) {
+      if (!in_window_) {
+        in_window_ = true;
+        window_start_J_ = prev_end_J_;
       }
-      r.rest_energy_rise_J = std::max(r.rest_energy_rise_J, E - window_start_J);
-      r.rest_kinetic_max_J = std::max(r.rest_kinetic_max_J, row.kinetic_J);
+      r_->rest_energy_rise_J = std::max(r_->rest_energy_rise_J, E - window_start_J_);
+      r_->rest_kinetic_max_J = std::max(r_->rest_kinetic_max_J, row.kinetic_J);
     }
-    prev_end_J = E;
-    r.energy_motor_final_J = E;
-    r.energy_hand_final_J = row.energy_hand_J;
+    prev_end_J_ = E;
+    r_->energy_motor_final_J = E;
+    r_->energy_hand_final_J = row.energy_hand_J;
+  }
 
-    // what the scenario reached, from MuJoCo's true angles
-    const Vec3 from_pivot = row.p_true_mm - params.vm.pivot_mm;
-    r.min_pivot_distance_mm = std::min(r.min_pivot_distance_mm, from_pivot.norm());
+  // what the scenario reached, from MuJoCo's true angles
+  void reached(const TraceRow& row, const TraceRow* prev) {
+    const Vec3 from_pivot = row.p_true_mm - params_.vm.pivot_mm;
+    r_->min_pivot_distance_mm = std::min(r_->min_pivot_distance_mm, from_pivot.norm());
     if (from_pivot.norm() > 1e-9) {
-      const double c = std::abs(from_pivot.normalized().dot(pole_axis));
-      r.min_pole_angle_rad = std::min(r.min_pole_angle_rad, std::acos(std::min(1.0, c)));
+      const double c = std::abs(from_pivot.normalized().dot(pole_axis_));
+      r_->min_pole_angle_rad = std::min(r_->min_pole_angle_rad, std::acos(std::min(1.0, c)));
     }
-    r.max_reach_fraction =
-        std::max(r.max_reach_fraction, (row.p_true_mm - shoulder_mm).norm() / reach_mm);
-    r.min_q5_to_singular_rad = std::min(
-        r.min_q5_to_singular_rad, std::abs(0.5 * kPi - std::abs(wrap_angle(row.q_true_dh[4]))));
-    if (k > 0) {
+    r_->max_reach_fraction =
+        std::max(r_->max_reach_fraction, (row.p_true_mm - shoulder_mm_).norm() / reach_mm_);
+    r_->min_q5_to_singular_rad = std::min(
+        r_->min_q5_to_singular_rad, std::abs(0.5 * kPi - std::abs(wrap_angle(row.q_true_dh[4]))));
+    if (prev != nullptr) {
       // encoder speeds over the previous tick, device joints t1..t3
-      const TraceRow& prev = rows[k - 1];
-      const Joints dq = dh_to_device_joints(row.q_true_dh) - dh_to_device_joints(prev.q_true_dh);
-      r.max_encoder_speed_rad_s = std::max(
-          r.max_encoder_speed_rad_s, dq.head<3>().cwiseAbs().maxCoeff() / prev.period_s);
-      const Vec6 de = row.out.e - prev.out.e;
+      const Joints dq = dh_to_device_joints(row.q_true_dh) - dh_to_device_joints(prev->q_true_dh);
+      r_->max_encoder_speed_rad_s = std::max(
+          r_->max_encoder_speed_rad_s, dq.head<3>().cwiseAbs().maxCoeff() / prev->period_s);
+      const Vec6 de = row.out.e - prev->out.e;
       for (int i = 3; i < 6; ++i) {
         if (std::abs(de[i]) > kPi) {
-          ++r.orientation_wraps;
+          ++r_->orientation_wraps;
           break;
         }
       }
     }
-    r.min_period_s = std::min(r.min_period_s, row.period_s);
-    r.max_period_s = std::max(r.max_period_s, row.period_s);
-    period_sum += row.period_s;
+    r_->min_period_s = std::min(r_->min_period_s, row.period_s);
+    r_->max_period_s = std::max(r_->max_period_s, row.period_s);
+    period_sum_ += row.period_s;
   }
-  r.mean_period_s = rows.empty() ? 0.0 : period_sum / static_cast<double>(rows.size());
 
-  for (int b = 0; b < kStatusFlagCount; ++b) {
-    if (seen & (1u << b)) statuses.insert(status_flag_name(1u << b));
-  }
-  r.statuses.assign(statuses.begin(), statuses.end());
-  r.device_errors.assign(device_errors.begin(), device_errors.end());
-  r.guard_faults.assign(guard_faults.begin(), guard_faults.end());
-  for (int i = 0; i < mjNWARNING; ++i) r.mujoco_warnings += loop.data()->warning[i].number;
+  const ControllerParams& params_;
+  ExtremeResult* r_;
+  const Vec3 shoulder_mm_;
+  const double reach_mm_;
+  const double window_from_s_;  // the rest's last window starts here
+  const Vec3 pole_axis_;
+  std::set<std::string> statuses_, device_errors_, guard_faults_;
+  ControlStatus seen_ = kStatusOk;
+  double period_sum_ = 0.0;
+  bool in_window_ = false;
+  double window_start_J_ = 0.0;
+  double prev_end_J_ = 0.0;  // the observer at the end of the last tick
+};
 
-  // -- judgement --
-  r.force_within_limit = r.max_force_N <= r.force_limit_N * (1.0 + 1e-12);
-  r.torque_within_limit = true;
+// The limits, the energy (the observer, and Colgate & Schenkel's bound for
+// this scenario's translational gains) and what it is expected to do.
+void judge(const ClosedLoop& loop, bool in_window, ExtremeResult* r) {
+  r->force_within_limit = r->max_force_N <= r->force_limit_N * (1.0 + 1e-12);
+  r->torque_within_limit = true;
   for (int i = 0; i < 3; ++i) {
-    r.torque_within_limit &= r.max_motor_torque_Nm[i] <= r.motor_limit_Nm[i] * (1.0 + 1e-12);
+    r->torque_within_limit &= r->max_motor_torque_Nm[i] <= r->motor_limit_Nm[i] * (1.0 + 1e-12);
   }
-  r.passive = r.energy_motor_max_J <= kPassiveToleranceJ;
-  r.energy_bounded = in_window && r.rest_energy_rise_J <= kRestEnergyRiseBoundJ;
+  r->passive = r->energy_motor_max_J <= kPassiveToleranceJ;
+  r->energy_bounded = in_window && r->rest_energy_rise_J <= kRestEnergyRiseBoundJ;
 
   // Colgate & Schenkel's bound for this scenario's translational gains
   const CaseConfig& c = loop.config();
-  const double T_max_s = loop.substeps_max() * m->opt.timestep;
-  r.colgate_demand_Ns_per_m = 1000.0 * c.controller.k_pos_N_per_mm * T_max_s / 2.0 +
+  const double T_max_s = loop.substeps_max() * loop.model()->opt.timestep;
+  r->colgate_demand_Ns_per_m = 1000.0 * c.controller.k_pos_N_per_mm * T_max_s / 2.0 +
                               1000.0 * std::abs(c.controller.k_vel_Ns_per_mm);
-  r.colgate_b_Ns_per_m = c.hand.b_pos_Ns_per_m;
-  r.colgate_passive = r.colgate_b_Ns_per_m > r.colgate_demand_Ns_per_m;
-  r.energy_expected = s.energy;
-  if (r.energy_expected == "bounded" && !r.colgate_passive) r.energy_expected = "either";
+  r->colgate_b_Ns_per_m = c.hand.b_pos_Ns_per_m;
+  r->colgate_passive = r->colgate_b_Ns_per_m > r->colgate_demand_Ns_per_m;
+  r->energy_expected = r->scenario.energy;
+  if (r->energy_expected == "bounded" && !r->colgate_passive) r->energy_expected = "either";
+}
 
+// ok, limit_cycle, fault_detected:<name>, fault_undetected:<fault> or
+// failed:<reasons> (ExtremeResult::outcome)
+std::string outcome_of(const ExtremeResult& r) {
+  const ExtremeScenario& s = r.scenario;
   std::vector<std::string> failures;
   if (!r.finite) failures.push_back("nonfinite");
   if (!r.force_within_limit) failures.push_back("force_above_limit");
@@ -377,340 +413,90 @@ ExtremeResult run_extreme(const ExtremeScenario& s,
                                has("invalid_input") || has("numerical_fault");
   if (s.injected == "none" && any_fault_named) failures.push_back("false_alarm");
 
-  if (!failures.empty()) {
-    r.outcome = "failed:" + join(failures, "+");
-  } else if (s.injected != "none") {
-    if (r.detection_tick >= 0) {
-      std::string what = !r.guard_faults.empty() ? r.guard_faults.front()
-                         : has("invalid_input") ? "invalid_input"
-                         : !r.device_errors.empty() ? r.device_errors.front()
-                                                    : "fault";
-      r.outcome = "fault_detected:" + what;
-    } else {
-      r.outcome = "fault_undetected:" + s.injected;
-    }
-  } else if (!r.energy_bounded) {
-    r.outcome = "limit_cycle";
-  } else {
-    r.outcome = "ok";
+  if (!failures.empty()) return "failed:" + join(failures, "+");
+  if (s.injected != "none") {
+    if (r.detection_tick < 0) return "fault_undetected:" + s.injected;
+    const std::string what = !r.guard_faults.empty() ? r.guard_faults.front()
+                             : has("invalid_input") ? "invalid_input"
+                             : !r.device_errors.empty() ? r.device_errors.front()
+                                                        : "fault";
+    return "fault_detected:" + what;
   }
-  return r;
+  return r.energy_bounded ? "ok" : "limit_cycle";
 }
 
-}  // namespace vmh::sim
-
-namespace vmh::sim {
-namespace {
-
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
-// one scenario's time series: what the observer and the command did
-std::string series_csv(const std::vector<TraceRow>& rows) {
-  std::string s =
-      "t_s,period_s,F_N,tau_1_Nm,tau_2_Nm,tau_3_Nm,energy_motor_J,"
-      "energy_hand_J,kinetic_J,d_pivot_mm,status,read,guard\n";
-  s.reserve(rows.size() * 160);
-  char buf[320];
-  for (const TraceRow& r : rows) {
-    std::snprintf(buf, sizeof buf,
-                  "%.6f,%.6g,%.6g,%.6g,%.6g,%.6g,%.9g,%.9g,%.9g,%.6g,%u,%s,%s\n",
-                  r.t_s, r.period_s, r.out.force_device_N.norm(),
-                  r.motor_torque_Nm[0], r.motor_torque_Nm[1], r.motor_torque_Nm[2],
-                  r.energy_motor_J, r.energy_hand_J, r.kinetic_J,
-                  r.p_true_mm.norm(), static_cast<unsigned>(r.out.status),
-                  device_error_name(r.servo.read), guard_fault_name(r.guard));
-    s += buf;
-  }
-  return s;
-}
-
-// XML text: & < > " escaped
-std::string xml_text(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
+// the table, or the scenarios named in `only` in that order; SimError for
+// an unknown name, listing the known ones
+std::vector<ExtremeScenario> pick_scenarios(const std::vector<std::string>& only) {
+  const std::vector<ExtremeScenario> table = extreme_scenarios();
+  if (only.empty()) return table;
+  std::vector<ExtremeScenario> picked;
+  for (const std::string& n : only) {
+    auto it = std::find_if(table.begin(), table.end(),
+                           [&n](const ExtremeScenario& s) { return s.name == n; });
+    if (it == table.end()) {
+      std::string names;
+      for (const ExtremeScenario& s : table) names += (names.empty() ? "" : ", ") + s.name;
+      throw SimError("unknown extreme scenario '" + n + "' (known: " + names + ")");
     }
+    picked.push_back(*it);
   }
-  return o;
-}
-
-const char* outcome_colour(const std::string& outcome) {
-  if (outcome == "ok") return "#2e7d32";
-  if (outcome == "limit_cycle") return "#e65100";
-  if (outcome.rfind("fault_detected", 0) == 0) return "#1565c0";
-  if (outcome.rfind("fault_undetected", 0) == 0) return "#6a1b9a";
-  return "#c62828";
-}
-
-// One small panel per scenario: the passivity observer E(t) in mJ over the
-// whole run, its own vertical scale (min and max labelled), zero dashed, the
-// end of the script dashed, the rest window the study judges shaded.
-std::string energy_panels_svg(const std::vector<ExtremeResult>& results,
-                              const std::vector<std::vector<double>>& t_s,
-                              const std::vector<std::vector<double>>& e_J) {
-  const int cols = 5, pw = 230, ph = 132, pad = 10, top = 58;
-  const int rows = (static_cast<int>(results.size()) + cols - 1) / cols;
-  const int W = cols * pw, H = top + rows * ph + 10;
-  const int gx = 46, gy = 30, gw = pw - gx - pad, gh = ph - gy - 22;
-  std::string s;
-  char b[512];
-  std::snprintf(b, sizeof b,
-                "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"extremes\" "
-                "width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\" "
-                "font-family=\"sans-serif\">\n<rect width=\"%d\" height=\"%d\" "
-                "fill=\"white\"/>\n",
-                W, H, W, H, W, H);
-  s += b;
-  s += "<text x=\"10\" y=\"22\" font-size=\"15\">Extreme cases: the "
-       "passivity observer E(t), energy the motors put into the device "
-       "(mJ)</text>\n<text x=\"10\" y=\"42\" font-size=\"11\" "
-       "fill=\"#555\">t from 0 to the end of the rest; dashed vertical: end "
-       "of the script; grey: the window judged (E may rise at most ";
-  std::snprintf(b, sizeof b, "%.3g mJ", 1e3 * kRestEnergyRiseBoundJ);
-  s += b;
-  s += " there); colour: outcome</text>\n";
-  for (std::size_t i = 0; i < results.size(); ++i) {
-    const ExtremeResult& r = results[i];
-    const int x0 = static_cast<int>(i % cols) * pw, y0 = top + static_cast<int>(i / cols) * ph;
-    const std::vector<double>& T = t_s[i];
-    const std::vector<double>& E = e_J[i];
-    double t_end = r.simulated_s > 0.0 ? r.simulated_s : 1.0;
-    double lo = 0.0, hi = 0.0;
-    for (double e : E) {
-      lo = std::min(lo, 1e3 * e);
-      hi = std::max(hi, 1e3 * e);
-    }
-    if (hi - lo < 1e-6) hi = lo + 1.0;
-    auto X = [&](double t) { return x0 + gx + gw * t / t_end; };
-    auto Y = [&](double mJ) { return y0 + gy + gh * (hi - mJ) / (hi - lo); };
-    std::snprintf(b, sizeof b, "<g class=\"panel\" id=\"panel-%s\">\n",
-                  xml_text(r.scenario.name).c_str());
-    s += b;
-    std::snprintf(b, sizeof b,
-                  "<text x=\"%d\" y=\"%d\" font-size=\"11\">%s</text>\n"
-                  "<text x=\"%d\" y=\"%d\" font-size=\"10\" fill=\"%s\">%s</text>\n",
-                  x0 + 6, y0 + 12, xml_text(r.scenario.name).c_str(), x0 + 6,
-                  y0 + 24, outcome_colour(r.outcome), xml_text(r.outcome).c_str());
-    s += b;
-    const double script_end = t_end - kExtremeRestS;
-    std::snprintf(b, sizeof b,
-                  "<rect x=\"%.1f\" y=\"%d\" width=\"%.1f\" height=\"%d\" "
-                  "fill=\"#e0e0e0\"/>\n<rect x=\"%d\" y=\"%d\" width=\"%d\" "
-                  "height=\"%d\" fill=\"none\" stroke=\"#999\"/>\n",
-                  X(t_end - kRestWindowS), y0 + gy, X(t_end) - X(t_end - kRestWindowS),
-                  gh, x0 + gx, y0 + gy, gw, gh);
-    s += b;
-    std::snprintf(b, sizeof b,
-                  "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" "
-                  "stroke=\"#999\" stroke-dasharray=\"3,3\"/>\n"
-                  "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" "
-                  "stroke=\"#bbb\" stroke-dasharray=\"2,2\"/>\n",
-                  X(script_end), y0 + gy, X(script_end), y0 + gy + gh, x0 + gx,
-                  Y(0.0), x0 + gx + gw, Y(0.0));
-    s += b;
-    std::snprintf(b, sizeof b,
-                  "<text x=\"%d\" y=\"%d\" font-size=\"9\" text-anchor=\"end\">%.3g</text>\n"
-                  "<text x=\"%d\" y=\"%d\" font-size=\"9\" text-anchor=\"end\">%.3g</text>\n"
-                  "<text x=\"%d\" y=\"%d\" font-size=\"9\">0</text>\n"
-                  "<text x=\"%d\" y=\"%d\" font-size=\"9\" text-anchor=\"end\">%.0f s</text>\n",
-                  x0 + gx - 3, y0 + gy + 8, hi, x0 + gx - 3, y0 + gy + gh, lo,
-                  x0 + gx, y0 + gy + gh + 11, x0 + gx + gw, y0 + gy + gh + 11, t_end);
-    s += b;
-    s += "<polyline fill=\"none\" stroke=\"#1565c0\" stroke-width=\"1\" points=\"";
-    for (std::size_t k = 0; k < T.size(); ++k) {
-      std::snprintf(b, sizeof b, "%.1f,%.1f ", X(T[k]), Y(1e3 * E[k]));
-      s += b;
-    }
-    s += "\"/>\n</g>\n";
-  }
-  s += "</svg>\n";
-  return s;
+  return picked;
 }
 
 }  // namespace
 
-nlohmann::json extreme_result_json(const ExtremeResult& r) {
-  const ExtremeScenario& s = r.scenario;
-  auto v3 = [](const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
-  return {
-      {"name", s.name},
-      {"base", s.base},
-      {"overrides", s.overrides},
-      {"stresses", s.stresses},
-      {"injected_fault", s.injected},
-      {"expected_status", s.expected},
-      {"outcome", r.outcome},
-      {"pass", r.pass()},
-      {"simulated_s", r.simulated_s},
-      {"ticks", r.ticks},
-      {"wall_time_s", r.wall_time_s},
-      {"finite", r.finite},
-      {"first_nonfinite", r.first_nonfinite},
-      {"nonfinite_reading_ticks", r.nonfinite_reading_ticks},
-      {"force_limit_N", r.force_limit_N},
-      {"max_force_N", r.max_force_N},
-      {"motor_limit_Nm", v3(r.motor_limit_Nm)},
-      {"max_motor_torque_Nm", v3(r.max_motor_torque_Nm)},
-      {"force_within_limit", r.force_within_limit},
-      {"torque_within_limit", r.torque_within_limit},
-      {"energy",
-       {{"motor_max_J", r.energy_motor_max_J},
-        {"motor_min_J", r.energy_motor_min_J},
-        {"motor_final_J", r.energy_motor_final_J},
-        {"hand_final_J", r.energy_hand_final_J},
-        {"kinetic_max_J", r.kinetic_max_J},
-        {"rest_rise_J", r.rest_energy_rise_J},
-        {"rest_rise_bound_J", kRestEnergyRiseBoundJ},
-        {"rest_kinetic_max_J", r.rest_kinetic_max_J},
-        {"bounded", r.energy_bounded},
-        {"passive", r.passive},
-        {"passive_tolerance_J", kPassiveToleranceJ},
-        {"expected", r.energy_expected},
-        {"expected_why", s.energy_why}}},
-      {"colgate",
-       {{"demand_Ns_per_m", r.colgate_demand_Ns_per_m},
-        {"b_Ns_per_m", r.colgate_b_Ns_per_m},
-        {"passive", r.colgate_passive}}},
-      {"statuses", r.statuses},
-      {"device_errors", r.device_errors},
-      {"guard_faults", r.guard_faults},
-      {"zeroed_ticks", r.zeroed_ticks},
-      {"mujoco_warnings", r.mujoco_warnings},
-      {"fault_tick", r.fault_tick},
-      {"detection_tick", r.detection_tick},
-      {"detection_latency_ticks",
-       r.fault_tick >= 0 && r.detection_tick >= 0 ? r.detection_tick - r.fault_tick : -1},
-      {"max_torque_after_detection_Nm", r.max_torque_after_detection_Nm},
-      {"reached",
-       {{"min_pivot_distance_mm", r.min_pivot_distance_mm},
-        {"orientation_wraps", r.orientation_wraps},
-        {"min_q5_to_singular_rad", r.min_q5_to_singular_rad},
-        {"min_pole_angle_rad", r.min_pole_angle_rad},
-        {"max_reach_fraction", r.max_reach_fraction},
-        {"max_encoder_speed_rad_s", r.max_encoder_speed_rad_s},
-        {"min_period_s", r.min_period_s},
-        {"max_period_s", r.max_period_s},
-        {"mean_period_s", r.mean_period_s}}},
-  };
+ExtremeResult run_extreme(const ExtremeScenario& s,
+                          std::vector<TraceRow>* trace) {
+  ExtremeResult r;
+  r.scenario = s;
+  std::string name;
+  const std::string scene = resolve_scene(s.base, &name);
+  std::vector<std::string> sets = {"duration_s=" + std::to_string(kExtremeDurationS)};
+  sets.insert(sets.end(), s.overrides.begin(), s.overrides.end());
+  ClosedLoop loop(scene, sets);
+  read_limits(loop, &r);
+  const double script_end_s = loop.config().sim.duration_s;
+  const double end_s = script_end_s + kExtremeRestS;
+
+  std::vector<TraceRow> local;
+  std::vector<TraceRow>& rows = trace != nullptr ? *trace : local;
+  run_ticks(&loop, end_s, &rows, &r);
+
+  TickScan scan(loop, end_s, &r);
+  for (std::size_t k = 0; k < rows.size(); ++k) scan.add(rows, k);
+  scan.finish(rows.size());
+  for (int i = 0; i < mjNWARNING; ++i) r.mujoco_warnings += loop.data()->warning[i].number;
+
+  judge(loop, scan.in_window(), &r);
+  r.outcome = outcome_of(r);
+  return r;
 }
 
-std::string extremes_csv(const std::vector<ExtremeResult>& results) {
-  std::string s =
-      "name,base,injected_fault,expected_status,outcome,finite,max_force_N,"
-      "force_limit_N,max_tau_1_Nm,max_tau_2_Nm,max_tau_3_Nm,"
-      "energy_motor_max_J,energy_motor_min_J,energy_motor_final_J,"
-      "rest_energy_rise_J,energy_hand_final_J,kinetic_max_J,"
-      "rest_kinetic_max_J,energy_bounded,passive,energy_expected,"
-      "colgate_demand_Ns_per_m,colgate_b_Ns_per_m,statuses,device_errors,guard_faults,zeroed_ticks,"
-      "mujoco_warnings,detection_latency_ticks,min_pivot_distance_mm,"
-      "min_pole_angle_rad,orientation_wraps,min_q5_to_singular_rad,"
-      "max_reach_fraction,max_encoder_speed_rad_s,min_period_s,max_period_s,"
-      "simulated_s,ticks,wall_time_s\n";
-  char buf[640];
-  for (const ExtremeResult& r : results) {
-    s += csv_field(r.scenario.name) + "," + r.scenario.base + "," +
-         r.scenario.injected + "," + r.scenario.expected + "," +
-         csv_field(r.outcome) + "," + (r.finite ? "1" : "0") + ",";
-    std::snprintf(buf, sizeof buf,
-                  "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,"
-                  "%.6g,%d,%d,",
-                  r.max_force_N, r.force_limit_N, r.max_motor_torque_Nm[0],
-                  r.max_motor_torque_Nm[1], r.max_motor_torque_Nm[2],
-                  r.energy_motor_max_J, r.energy_motor_min_J,
-                  r.energy_motor_final_J, r.rest_energy_rise_J,
-                  r.energy_hand_final_J, r.kinetic_max_J, r.rest_kinetic_max_J,
-                  r.energy_bounded ? 1 : 0, r.passive ? 1 : 0);
-    s += buf;
-    s += r.energy_expected + ",";
-    std::snprintf(buf, sizeof buf, "%.6g,%.6g,", r.colgate_demand_Ns_per_m,
-                  r.colgate_b_Ns_per_m);
-    s += buf;
-    s += csv_field(join(r.statuses, " ")) + "," +
-         csv_field(join(r.device_errors, " ")) + "," +
-         csv_field(join(r.guard_faults, " ")) + ",";
-    std::snprintf(buf, sizeof buf,
-                  "%d,%d,%d,%.6g,%.6g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%.6g\n",
-                  r.zeroed_ticks, r.mujoco_warnings,
-                  r.fault_tick >= 0 && r.detection_tick >= 0
-                      ? r.detection_tick - r.fault_tick
-                      : -1,
-                  r.min_pivot_distance_mm, r.min_pole_angle_rad,
-                  r.orientation_wraps, r.min_q5_to_singular_rad,
-                  r.max_reach_fraction, r.max_encoder_speed_rad_s,
-                  r.min_period_s, r.max_period_s, r.simulated_s, r.ticks,
-                  r.wall_time_s);
-    s += buf;
-  }
-  return s;
-}
-
-nlohmann::json run_extremes_study(const std::vector<std::string>& only,
-                                  const std::string& out_dir, int jobs,
-                                  std::vector<ExtremeResult>* results) {
-  std::vector<ExtremeScenario> table = extreme_scenarios();
-  if (!only.empty()) {
-    std::vector<ExtremeScenario> picked;
-    for (const std::string& n : only) {
-      auto it = std::find_if(table.begin(), table.end(),
-                             [&n](const ExtremeScenario& s) { return s.name == n; });
-      if (it == table.end()) {
-        std::string names;
-        for (const ExtremeScenario& s : table) names += (names.empty() ? "" : ", ") + s.name;
-        throw SimError("unknown extreme scenario '" + n + "' (known: " + names + ")");
-      }
-      picked.push_back(*it);
-    }
-    table = picked;
-  }
-  if (!out_dir.empty()) {
+ExtremesResult run_extremes_study(const ExtremesOptions& o) {
+  const std::vector<ExtremeScenario> table = pick_scenarios(o.only);
+  if (!o.out_dir.empty()) {
     std::error_code ec;
-    fs::create_directories(fs::path(out_dir) / "extremes", ec);
-    if (ec) throw SimError(out_dir + ": " + ec.message());
+    fs::create_directories(fs::path(o.out_dir) / "extremes", ec);
+    if (ec) throw SimError(o.out_dir + ": " + ec.message());
   }
   // the scenarios are independent: run them on `jobs` threads (ClosedLoop
   // finds its hand through a thread-local pointer, and model loading is
   // serialised), each keeping its time series only as long as it needs it
-  results->assign(table.size(), ExtremeResult{});
-  std::vector<std::vector<double>> energy_t(table.size()), energy_J(table.size());
+  ExtremesResult result;
+  result.scenarios.assign(table.size(), ExtremeResult{});
+  result.energy.assign(table.size(), EnergyCurve{});
   std::vector<std::string> errors(table.size());
   const auto start = std::chrono::steady_clock::now();
-  parallel_for(table.size(), jobs, [&](std::size_t i) {
+  report::parallel_for(table.size(), o.jobs, [&](std::size_t i) {
     std::vector<TraceRow> rows;
     try {
-      (*results)[i] = run_extreme(table[i], &rows);
-      // the observer, thinned for the figure to about 400 buckets, each
-      // drawn by its lowest and highest point in time order, so that no
-      // peak or dip is lost to the thinning (the table's max and min are
-      // the curve's)
-      const std::size_t stride = std::max<std::size_t>(1, rows.size() / 400);
-      for (std::size_t k0 = 0; k0 < rows.size(); k0 += stride) {
-        const std::size_t k1 = std::min(rows.size(), k0 + stride);
-        std::size_t lo = k0, hi = k0;
-        for (std::size_t k = k0; k < k1; ++k) {
-          if (rows[k].energy_motor_J < rows[lo].energy_motor_J) lo = k;
-          if (rows[k].energy_motor_J > rows[hi].energy_motor_J) hi = k;
-        }
-        for (std::size_t k : {std::min(lo, hi), std::max(lo, hi)}) {
-          if (k == std::max(lo, hi) && lo == hi) break;
-          energy_t[i].push_back(rows[k].t_s);
-          energy_J[i].push_back(rows[k].energy_motor_J);
-        }
-      }
-      if (!out_dir.empty()) {
-        write_file_atomically(
-            (fs::path(out_dir) / "extremes" / (table[i].name + ".csv")).string(),
-            series_csv(rows));
+      result.scenarios[i] = run_extreme(table[i], &rows);
+      result.energy[i] = thin_energy(rows);
+      if (!o.out_dir.empty()) {
+        report::write_file_atomically(
+            (fs::path(o.out_dir) / "extremes" / (table[i].name + ".csv")).string(),
+            extreme_series_csv(rows));
       }
     } catch (const std::exception& e) {
       errors[i] = table[i].name + ": " + e.what();
@@ -719,35 +505,15 @@ nlohmann::json run_extremes_study(const std::vector<std::string>& only,
   for (const std::string& e : errors) {
     if (!e.empty()) throw SimError(e);
   }
-  const double wall =
+  result.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  nlohmann::json scenarios = nlohmann::json::array();
-  bool all_pass = true;
-  for (const ExtremeResult& r : *results) {
-    scenarios.push_back(extreme_result_json(r));
-    all_pass &= r.pass();
-  }
-  nlohmann::json j = {
-      {"study", "extremes"},
-      {"duration_s", kExtremeDurationS},
-      {"rest_s", kExtremeRestS},
-      {"bounds",
-       {{"rest_s", kExtremeRestS},
-        {"rest_window_s", kRestWindowS},
-        {"rest_energy_rise_bound_J", kRestEnergyRiseBoundJ},
-        {"passive_tolerance_J", kPassiveToleranceJ}}},
-      {"scenarios", scenarios},
-      {"all_pass", all_pass},
-      {"wall_time_s", wall},
-  };
-  if (!out_dir.empty()) {
-    write_file_atomically((fs::path(out_dir) / "extremes.csv").string(), extremes_csv(*results));
-    write_file_atomically((fs::path(out_dir) / "extremes.json").string(), j.dump(2) + "\n");
-    write_file_atomically((fs::path(out_dir) / "extremes.svg").string(),
-energy_panels_svg(*results, energy_t, energy_J));
-  }
-  return j;
+  if (!o.out_dir.empty()) write_extremes_files(result, o.out_dir);
+  return result;
 }
 
-}  // namespace vmh::sim
+bool ExtremesResult::all_pass() const {
+  return std::all_of(scenarios.begin(), scenarios.end(),
+                     [](const ExtremeResult& r) { return r.pass(); });
+}
+
+}  // namespace vmh::studies

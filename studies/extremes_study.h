@@ -19,12 +19,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
+#include "report/svg_chart.h"
 #include "sim/closed_loop.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 struct ExtremeScenario {
   std::string name;
@@ -41,7 +43,7 @@ struct ExtremeScenario {
   std::string expected;
   // what the energy must do: "bounded" (required), or "limit_cycle" (a
   // known instability, with the reason in energy_why and a test of its own
-  // in tests/sim/extremes_study_test.cc). A "bounded" scenario whose
+  // in tests/studies/extremes_study_test.cc). A "bounded" scenario whose
   // translational gain breaks Colgate & Schenkel's passivity bound is
   // relaxed to "either" when it runs (ExtremeResult::energy_expected):
   // sampled-data theory then allows a limit cycle without requiring one.
@@ -155,22 +157,60 @@ struct ExtremeResult {
 // Runs one scenario. With `trace` non-null, fills it with every tick's row.
 // Throws SimError on bad input (a bad override, an unreachable start pose).
 ExtremeResult run_extreme(const ExtremeScenario& s,
-                          std::vector<TraceRow>* trace = nullptr);
+                          std::vector<sim::TraceRow>* trace = nullptr);
+
+struct ExtremesOptions {
+  std::vector<std::string> only;  // scenario names, in this order; empty: all
+  // where the files go (below); empty: nothing is written
+  std::string out_dir;
+  int jobs = 1;  // scenarios run at once, each on its own thread
+};
+
+// The passivity observer E(t) of one scenario, thinned for the figure
+// (thin_energy).
+struct EnergyCurve {
+  std::vector<double> t_s;
+  std::vector<double> energy_J;
+};
+
+struct ExtremesResult {
+  std::vector<ExtremeResult> scenarios;  // in the order run
+  std::vector<EnergyCurve> energy;       // one per scenario, same order
+  double wall_time_s = 0.0;              // the whole study
+  bool all_pass() const;
+};
 
 // Runs every scenario of extreme_scenarios() (or those named in `only`) on
 // `jobs` threads, and, if out_dir is not empty, writes out_dir/extremes.csv,
-// out_dir/extremes.json, out_dir/extremes.svg (the observer's E(t), one
-// panel per scenario) and out_dir/extremes/<name>.csv (a time series per
-// scenario). Returns the JSON (what extremes.json holds). Throws SimError
-// naming the scenario on bad input.
-nlohmann::json run_extremes_study(const std::vector<std::string>& only,
-                                  const std::string& out_dir, int jobs,
-                                  std::vector<ExtremeResult>* results);
+// out_dir/extremes.json (extremes_json), out_dir/extremes.svg (the
+// observer's E(t), one panel per scenario) and out_dir/extremes/<name>.csv
+// (a time series per scenario). Throws SimError naming the scenario on bad
+// input.
+ExtremesResult run_extremes_study(const ExtremesOptions& options);
 
+// ---------------------------------------------------------------- output
+// (extremes_output.cc)
+
+// what extremes.json holds: the bounds, every scenario, all_pass
+nlohmann::json extremes_json(const ExtremesResult& r);
 nlohmann::json extreme_result_json(const ExtremeResult& r);
 // the CSV's header and one row per result
 std::string extremes_csv(const std::vector<ExtremeResult>& results);
+// one scenario's time series, a row per tick: what the observer and the
+// command did (extremes/<name>.csv)
+std::string extreme_series_csv(const std::vector<sim::TraceRow>& rows);
+// E(t) thinned to about `buckets` buckets, each drawn by its lowest and
+// highest point in time order, so that no peak or dip is lost to the
+// thinning (the table's max and min are the curve's)
+EnergyCurve thin_energy(const std::vector<sim::TraceRow>& rows,
+                        std::size_t buckets = 400);
+// the figure: one panel per scenario, E(t) in mJ over the whole run, the
+// end of the script dashed, the rest window the study judges shaded, the
+// outcome under the name in its colour
+report::ChartGrid extremes_figure(const ExtremesResult& r);
+// writes the study's files under out_dir (not the per-scenario series)
+void write_extremes_files(const ExtremesResult& r, const std::string& out_dir);
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_EXTREMES_STUDY_H_

@@ -11,10 +11,13 @@
 #include "controller/controller.h"
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "report/output_file.h"
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -162,6 +165,110 @@ const std::vector<LeannessVariant>& leanness_variants() {
   return variants;
 }
 
+namespace {
+
+// A case's loops, one per variant in leanness_variants() order, each with
+// the variant's ingredients switched on.
+std::vector<VariantLoop> make_loops(const std::string& scene,
+                                    const std::vector<std::string>& sets) {
+  std::vector<VariantLoop> loops;
+  for (const LeannessVariant& variant : leanness_variants()) {
+    VariantLoop v;
+    v.variant = variant;
+    v.result.variant = variant;
+    v.result.wall_time_s = std::numeric_limits<double>::infinity();
+    v.result.cpu_time_s = std::numeric_limits<double>::infinity();
+    v.loop = std::make_unique<ClosedLoop>(scene, sets);
+    switch_on(v.loop.get(), variant.ingredients);
+    if (variant.ingredients & kRendering) {
+      v.viewer = std::make_unique<ViewerState>(v.loop->model());
+    }
+    loops.push_back(std::move(v));
+  }
+  return loops;
+}
+
+// the controller alone over the composed run's readings, least CPU time
+double controller_cpu_s(const VariantLoop& composed, int repeats) {
+  double controller_s = std::numeric_limits<double>::infinity();
+  for (int rep = 0; rep < repeats; ++rep) {
+    Controller controller(composed.loop->controller_params());
+    ControlOutput out;
+    const double cpu0 = thread_cpu_s();
+    for (const Joints& q : composed.q_read) controller.tick(q, &out);
+    controller_s = std::min(controller_s, thread_cpu_s() - cpu0);
+  }
+  return controller_s;
+}
+
+// A variant's rates and slowdowns against the composed scene's, what its
+// model switched on, and how far it moved from the composed run.
+VariantResult variant_result(const VariantLoop& v, const VariantLoop& composed,
+                             const CaseLeanness& cl) {
+  const double steps = static_cast<double>(cl.ticks) * cl.substeps;
+  const double simulated_s = cl.ticks * composed.loop->controller_params().servo_period_s;
+  const double composed_s = composed.result.wall_time_s;
+  const double composed_cpu_s = composed.result.cpu_time_s;
+  const double controller_s = cl.controller_cpu_time_s;
+  VariantResult r = v.result;
+  const mjModel* m = v.loop->model();
+  r.steps_per_s = steps / r.wall_time_s;
+  r.cpu_steps_per_s = steps / r.cpu_time_s;
+  r.realtime_factor = simulated_s / r.wall_time_s;
+  r.slowdown = r.wall_time_s / composed_s;
+  r.cpu_slowdown = r.cpu_time_s / composed_cpu_s;
+  r.physics_slowdown = (r.cpu_time_s - controller_s) /
+                       std::max(composed_cpu_s - controller_s, 1e-12);
+  r.contact_enabled = !(m->opt.disableflags & mjDSBL_CONTACT);
+  r.gravity_enabled = !(m->opt.disableflags & mjDSBL_GRAVITY) &&
+                      (m->opt.gravity[0] != 0.0 || m->opt.gravity[1] != 0.0 ||
+                       m->opt.gravity[2] != 0.0);
+  r.frictionloss_enabled = !(m->opt.disableflags & mjDSBL_FRICTIONLOSS);
+  r.colliding_geoms = 0;
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_contype[g] != 0 || m->geom_conaffinity[g] != 0) {
+      ++r.colliding_geoms;
+    }
+  }
+  r.max_deviation_mm = 0.0;
+  for (std::size_t k = 0; k < v.p_mm.size(); ++k) {
+    r.max_deviation_mm =
+        std::max(r.max_deviation_mm, (v.p_mm[k] - composed.p_mm[k]).norm());
+  }
+  return r;
+}
+
+// One case: its variants run `repeats` times, interleaved.
+CaseLeanness measure_case(const std::pair<std::string, std::string>& scene,
+                          std::vector<VariantLoop>* loops_in, int repeats) {
+  std::vector<VariantLoop>& loops = *loops_in;
+  const ClosedLoop& first = *loops.front().loop;
+  CaseLeanness cl;
+  cl.name = scene.first;
+  cl.scene = scene.second;
+  cl.nv = first.model()->nv;
+  cl.ngeom = first.model()->ngeom;
+  cl.substeps = first.substeps();
+  cl.step_s = first.model()->opt.timestep;
+  cl.ticks = first.ticks_per_run();
+
+  // each repeat starts one variant further on, so that no variant always
+  // runs first (cold caches) or right after the same neighbour
+  for (int rep = 0; rep < repeats; ++rep) {
+    for (std::size_t i = 0; i < loops.size(); ++i) {
+      run_variant(&loops[(i + static_cast<std::size_t>(rep)) % loops.size()],
+                  cl.ticks);
+    }
+  }
+  cl.controller_cpu_time_s = controller_cpu_s(loops.front(), repeats);
+  for (const VariantLoop& v : loops) {
+    cl.variants.push_back(variant_result(v, loops.front(), cl));
+  }
+  return cl;
+}
+
+}  // namespace
+
 LeannessResult run_leanness_study(const LeannessOptions& o) {
   const auto study_start = Clock::now();
   LeannessResult result;
@@ -172,92 +279,17 @@ LeannessResult run_leanness_study(const LeannessOptions& o) {
   std::vector<std::string> sets = o.overrides;
   sets.push_back("duration_s=" + exact(o.duration_s));
   // every loop is built (and every scene checked) before the first run
-  std::vector<std::vector<VariantLoop>> all(o.scenes.size());
+  std::vector<std::vector<VariantLoop>> all;
+  for (const auto& scene : o.scenes) all.push_back(make_loops(scene.second, sets));
   for (std::size_t c = 0; c < o.scenes.size(); ++c) {
-    for (const LeannessVariant& variant : leanness_variants()) {
-      VariantLoop v;
-      v.variant = variant;
-      v.result.variant = variant;
-      v.result.wall_time_s = std::numeric_limits<double>::infinity();
-      v.result.cpu_time_s = std::numeric_limits<double>::infinity();
-      v.loop = std::make_unique<ClosedLoop>(o.scenes[c].second, sets);
-      switch_on(v.loop.get(), variant.ingredients);
-      if (variant.ingredients & kRendering) {
-        v.viewer = std::make_unique<ViewerState>(v.loop->model());
-      }
-      all[c].push_back(std::move(v));
-    }
-  }
-
-  for (std::size_t c = 0; c < o.scenes.size(); ++c) {
-    std::vector<VariantLoop>& loops = all[c];
-    const ClosedLoop& first = *loops.front().loop;
-    CaseLeanness cl;
-    cl.name = o.scenes[c].first;
-    cl.scene = o.scenes[c].second;
-    cl.nv = first.model()->nv;
-    cl.ngeom = first.model()->ngeom;
-    cl.substeps = first.substeps();
-    cl.step_s = first.model()->opt.timestep;
-    cl.ticks = first.ticks_per_run();
-
-    // each repeat starts one variant further on, so that no variant always
-    // runs first (cold caches) or right after the same neighbour
-    for (int rep = 0; rep < result.repeats; ++rep) {
-      for (std::size_t i = 0; i < loops.size(); ++i) {
-        run_variant(&loops[(i + static_cast<std::size_t>(rep)) % loops.size()],
-                    cl.ticks);
-      }
-    }
-
-    // the controller alone, over the composed run's readings
-    const VariantLoop& composed = loops.front();
-    double controller_s = std::numeric_limits<double>::infinity();
-    for (int rep = 0; rep < result.repeats; ++rep) {
-      Controller controller(composed.loop->controller_params());
-      ControlOutput out;
-      const double cpu0 = thread_cpu_s();
-      for (const Joints& q : composed.q_read) controller.tick(q, &out);
-      controller_s = std::min(controller_s, thread_cpu_s() - cpu0);
-    }
-    cl.controller_cpu_time_s = controller_s;
-
-    const double steps = static_cast<double>(cl.ticks) * cl.substeps;
-    const double simulated_s = cl.ticks * composed.loop->controller_params().servo_period_s;
-    const double composed_s = composed.result.wall_time_s;
-    const double composed_cpu_s = composed.result.cpu_time_s;
-    for (VariantLoop& v : loops) {
-      VariantResult r = v.result;
-      const mjModel* m = v.loop->model();
-      r.steps_per_s = steps / r.wall_time_s;
-      r.cpu_steps_per_s = steps / r.cpu_time_s;
-      r.realtime_factor = simulated_s / r.wall_time_s;
-      r.slowdown = r.wall_time_s / composed_s;
-      r.cpu_slowdown = r.cpu_time_s / composed_cpu_s;
-      r.physics_slowdown = (r.cpu_time_s - controller_s) /
-                           std::max(composed_cpu_s - controller_s, 1e-12);
-      r.contact_enabled = !(m->opt.disableflags & mjDSBL_CONTACT);
-      r.gravity_enabled = !(m->opt.disableflags & mjDSBL_GRAVITY) &&
-                          (m->opt.gravity[0] != 0.0 || m->opt.gravity[1] != 0.0 ||
-                           m->opt.gravity[2] != 0.0);
-      r.frictionloss_enabled = !(m->opt.disableflags & mjDSBL_FRICTIONLOSS);
-      r.colliding_geoms = 0;
-      for (int g = 0; g < m->ngeom; ++g) {
-        if (m->geom_contype[g] != 0 || m->geom_conaffinity[g] != 0) {
-          ++r.colliding_geoms;
-        }
-      }
-      r.max_deviation_mm = 0.0;
-      for (std::size_t k = 0; k < v.p_mm.size(); ++k) {
-        r.max_deviation_mm =
-            std::max(r.max_deviation_mm, (v.p_mm[k] - composed.p_mm[k]).norm());
-      }
-      cl.variants.push_back(r);
-    }
-    result.cases.push_back(cl);
+    result.cases.push_back(measure_case(o.scenes[c], &all[c], result.repeats));
   }
   result.study_wall_time_s =
       std::chrono::duration<double>(Clock::now() - study_start).count();
+  if (!o.out_dir.empty()) {
+    result.files = {report::write_file_in(o.out_dir, "leanness.csv",
+                                          leanness_csv(result))};
+  }
   return result;
 }
 
@@ -290,4 +322,95 @@ std::string leanness_csv(const LeannessResult& r) {
   return s;
 }
 
-}  // namespace vmh::sim
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+Json ingredient_names(unsigned ingredients) {
+  Json names = Json::array();
+  if (ingredients & kContacts) names.push_back("contacts");
+  if (ingredients & kGravity) names.push_back("gravity");
+  if (ingredients & kRendering) names.push_back("rendering");
+  if (ingredients & kNoFrictionloss) names.push_back("no_frictionloss");
+  return names;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+Json variant_json(const VariantResult& v) {
+  return {
+      {"variant", v.variant.name},
+      {"ingredients", ingredient_names(v.variant.ingredients)},
+      {"wall_time_s", v.wall_time_s},
+      {"cpu_time_s", v.cpu_time_s},
+      {"steps_per_s", v.steps_per_s},
+      {"cpu_steps_per_s", v.cpu_steps_per_s},
+      {"realtime_factor", v.realtime_factor},
+      {"slowdown", v.slowdown},
+      {"cpu_slowdown", v.cpu_slowdown},
+      {"physics_slowdown", v.physics_slowdown},
+      {"contact_enabled", v.contact_enabled},
+      {"colliding_geoms", v.colliding_geoms},
+      {"gravity_enabled", v.gravity_enabled},
+      {"frictionloss_enabled", v.frictionloss_enabled},
+      {"mean_ncon", v.mean_ncon},
+      {"max_ncon", v.max_ncon},
+      {"mean_nefc", v.mean_nefc},
+      {"max_nefc", v.max_nefc},
+      {"scene_geoms", v.scene_geoms},
+      {"render_us_per_tick", v.render_us_per_tick},
+      {"max_deviation_mm", v.max_deviation_mm},
+      {"mujoco_warnings", v.mujoco_warnings},
+  };
+}
+
+}  // namespace
+
+nlohmann::ordered_json leanness_json(const LeannessResult& r) {
+  Json cases = Json::array();
+  std::vector<std::vector<double>> slowdowns(leanness_variants().size());
+  for (const CaseLeanness& c : r.cases) {
+    Json variants = Json::array();
+    for (std::size_t i = 0; i < c.variants.size(); ++i) {
+      slowdowns[i].push_back(c.variants[i].cpu_slowdown);
+      variants.push_back(variant_json(c.variants[i]));
+    }
+    cases.push_back({{"case", c.name},
+                     {"scene", c.scene},
+                     {"nv", c.nv},
+                     {"ngeom", c.ngeom},
+                     {"h_s", c.step_s},
+                     {"substeps_per_tick", c.substeps},
+                     {"ticks", c.ticks},
+                     {"controller_cpu_time_s", c.controller_cpu_time_s},
+                     {"variants", variants}});
+  }
+  Json summary = Json::object();
+  for (std::size_t i = 0; i < leanness_variants().size(); ++i) {
+    summary[leanness_variants()[i].name] = {
+        {"median_cpu_slowdown", median(slowdowns[i])}};
+  }
+  Json j = {
+      {"study", "leanness"},
+      {"duration_s", r.duration_s},
+      {"script", "each case's whole script, compressed into duration_s"},
+      {"repeats", r.repeats},
+      {"not_measured",
+       {{"full_omni",
+         "every case scene already holds the full Omni (nv = 6): the "
+         "controller reads all six joints and the hand moves them, so no "
+         "lighter model would run the same case"}}},
+      {"median_over_cases", summary},
+      {"cases", cases},
+      {"study_wall_time_s", r.study_wall_time_s},
+  };
+  if (!r.files.empty()) j["files"] = r.files;
+  return j;
+}
+
+}  // namespace vmh::studies

@@ -29,10 +29,13 @@
 #ifndef VMHAPTICS_STUDIES_LEANNESS_STUDY_H_
 #define VMHAPTICS_STUDIES_LEANNESS_STUDY_H_
 
+#include <nlohmann/json.hpp>
+
 #include <string>
+#include <utility>
 #include <vector>
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 // what a variant switches on (or, for kNoFrictionloss, off)
 enum Ingredient : unsigned {
@@ -57,6 +60,7 @@ struct LeannessOptions {
   std::vector<std::string> overrides;
   double duration_s = 2.0;  // simulated per variant and repeat
   int repeats = 5;
+  std::string out_dir;  // where leanness.csv goes; empty: nothing written
 };
 
 struct VariantResult {
@@ -113,14 +117,20 @@ struct LeannessResult {
   int repeats = 0;
   std::vector<CaseLeanness> cases;
   double study_wall_time_s = 0.0;
+  std::vector<std::string> files;  // the paths written (out_dir)
 };
 
-// Throws SimError on a bad scene or override, before any run.
+// Runs the study and, with out_dir, writes out_dir/leanness.csv. Throws
+// SimError on a bad scene or override, before any run.
 LeannessResult run_leanness_study(const LeannessOptions& options);
 
 // one row per case and variant, units in the column names
 std::string leanness_csv(const LeannessResult& r);
 
-}  // namespace vmh::sim
+// What the command line prints: every case's variants, the median CPU
+// slowdown of each variant over the cases, and the files written.
+nlohmann::ordered_json leanness_json(const LeannessResult& r);
+
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_LEANNESS_STUDY_H_

@@ -12,14 +12,16 @@
 
 #include "report/svg_text.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
-using svg::attr;
-using svg::escape;
-using svg::format;
-using svg::nice_step;
-using svg::px;
+using report::svg::attr;
+using report::svg::escape;
+using report::svg::format;
+using report::svg::nice_step;
+using report::svg::px;
 
 using Pt = std::pair<double, double>;
 
@@ -669,4 +671,4 @@ std::string history_svg(const std::vector<TraceRow>& rows,
   return svg.finish();
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies

@@ -32,7 +32,7 @@
 
 #include "sim/closed_loop.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 // the views draw the force F as an arrow kPlotForceMmPerN x |F| mm long
 inline constexpr double kPlotForceMmPerN = 10.0;
@@ -41,11 +41,11 @@ inline constexpr double kPlotStylusMm = 15.0;
 // polylines keep at most this many rows, plus the run's last one
 inline constexpr std::size_t kPlotMaxPoints = 2000;
 
-std::string views_svg(const std::vector<TraceRow>& rows,
-                      const ClosedLoop& loop);
-std::string history_svg(const std::vector<TraceRow>& rows,
-                        const ClosedLoop& loop);
+std::string views_svg(const std::vector<sim::TraceRow>& rows,
+                      const sim::ClosedLoop& loop);
+std::string history_svg(const std::vector<sim::TraceRow>& rows,
+                        const sim::ClosedLoop& loop);
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_PLOT_SVG_H_

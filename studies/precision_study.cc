@@ -16,7 +16,9 @@
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -250,47 +252,42 @@ std::vector<bool> pareto_front(const std::vector<double>& x,
   return front;
 }
 
-PrecisionResult run_precision_study(const PrecisionOptions& o) {
-  const auto study_start = Clock::now();
-  PrecisionResult r;
-  r.scene = o.scene;
-  r.duration_s = o.duration_s;
+namespace {
 
-  // the scene's own setting, and every check before the first run: a loop
-  // built for each step of the ladder (the loader refuses a step that does
-  // not divide T, naming both)
-  {
-    ClosedLoop probe(o.scene, o.overrides);
-    r.servo_period_s = probe.controller_params().servo_period_s;
-    r.default_step_s = probe.model()->opt.timestep;
-    switch (probe.model()->opt.integrator) {
-      case mjINT_RK4: r.default_integrator = Integrator::kRk4; break;
-      case mjINT_IMPLICIT: r.default_integrator = Integrator::kImplicit; break;
-      default: r.default_integrator = Integrator::kEuler; break;
-    }
-    for (const ScriptSegment& seg : probe.script().segments()) {
-      if (seg.t0_s < o.duration_s) r.segments.push_back(seg);
-    }
-    const double script_s = probe.config().sim.duration_s;
-    if (!(o.duration_s > 0.0) || o.duration_s > script_s + 1e-12) {
-      throw SimError(o.scene + ": the study's duration (" +
-                     exact(o.duration_s) + " s) must be > 0 and at most the "
-                     "case's duration_s (" + exact(script_s) + " s)");
-    }
-  }
-  r.ticks = static_cast<int>(std::llround(o.duration_s / r.servo_period_s));
-  if (r.ticks < 1) throw SimError("the study's duration is under one servo tick");
-  if (o.integrators.empty()) throw SimError("no integrator to study");
-  if (!(o.reference_step_s > 0.0) ||
-      !(o.reference_check_step_s > o.reference_step_s)) {
-    throw SimError("the reference step must be > 0 and below the check step");
-  }
+// One setting of the ladder.
+struct Setting {
+  Integrator integrator;
+  double step_s;
+};
 
-  // the ladder per integrator, largest step first, the default added
-  struct Setting {
-    Integrator integrator;
-    double step_s;
-  };
+// The scene's own setting (integrator, step, servo period) and script
+// segments, read from a loop built once, and the duration checked against
+// the case's script.
+void probe_scene(const PrecisionOptions& o, PrecisionResult* r) {
+  ClosedLoop probe(o.scene, o.overrides);
+  r->servo_period_s = probe.controller_params().servo_period_s;
+  r->default_step_s = probe.model()->opt.timestep;
+  switch (probe.model()->opt.integrator) {
+    case mjINT_RK4: r->default_integrator = Integrator::kRk4; break;
+    case mjINT_IMPLICIT: r->default_integrator = Integrator::kImplicit; break;
+    default: r->default_integrator = Integrator::kEuler; break;
+  }
+  for (const ScriptSegment& seg : probe.script().segments()) {
+    if (seg.t0_s < o.duration_s) r->segments.push_back(seg);
+  }
+  const double script_s = probe.config().sim.duration_s;
+  if (!(o.duration_s > 0.0) || o.duration_s > script_s + 1e-12) {
+    throw SimError(o.scene + ": the study's duration (" +
+                   exact(o.duration_s) + " s) must be > 0 and at most the "
+                   "case's duration_s (" + exact(script_s) + " s)");
+  }
+}
+
+// The ladder per integrator, largest step first, the scene's own step added
+// for its own integrator; every step checked against the reference step
+// and the servo period (the loader would refuse one that does not divide
+// it), and the references' steps likewise.
+std::vector<Setting> ladder(const PrecisionOptions& o, const PrecisionResult& r) {
   std::vector<Setting> settings;
   for (Integrator i : o.integrators) {
     std::vector<double> steps = o.steps_s;
@@ -325,21 +322,25 @@ PrecisionResult run_precision_study(const PrecisionOptions& o) {
                      exact(r.servo_period_s) + " s");
     }
   }
+  return settings;
+}
 
-  // the two references, side by side (each loop has its own thread and
-  // finds its hand through a thread-local pointer)
+// The two references, side by side (each loop has its own thread and finds
+// its hand through a thread-local pointer); the check bounds the
+// reference's own error, which sets the fit's floor.
+Trajectory run_references(const PrecisionOptions& o, PrecisionResult* r) {
   Trajectory ref, ref_check;
   std::exception_ptr failure;
   std::thread check_thread([&] {
     try {
       ref_check = run_setting(o, Integrator::kRk4, o.reference_check_step_s,
-                              r.ticks, 0.0, 1);
+                              r->ticks, 0.0, 1);
     } catch (...) {
       failure = std::current_exception();
     }
   });
   try {
-    ref = run_setting(o, Integrator::kRk4, o.reference_step_s, r.ticks, 0.0, 1);
+    ref = run_setting(o, Integrator::kRk4, o.reference_step_s, r->ticks, 0.0, 1);
   } catch (...) {
     check_thread.join();
     throw;
@@ -350,41 +351,46 @@ PrecisionResult run_precision_study(const PrecisionOptions& o) {
     throw SimError(o.scene + ": the reference run blew up (MuJoCo warnings: " +
                    std::to_string(ref.mujoco_warnings) + ")");
   }
-  r.reference.step_s = o.reference_step_s;
-  r.reference.check_step_s = o.reference_check_step_s;
-  r.reference.wall_time_s = ref.wall_time_s;
-  r.reference.check_wall_time_s = ref_check.wall_time_s;
-  r.reference.self_error = compare(ref_check, ref);
-  r.floor_mm = kFloorFactor * r.reference.self_error.rms_mm;
+  r->reference.step_s = o.reference_step_s;
+  r->reference.check_step_s = o.reference_check_step_s;
+  r->reference.wall_time_s = ref.wall_time_s;
+  r->reference.check_wall_time_s = ref_check.wall_time_s;
+  r->reference.self_error = compare(ref_check, ref);
+  r->floor_mm = kFloorFactor * r->reference.self_error.rms_mm;
+  return ref;
+}
 
-  // the ladder, one run at a time, so that the timings do not compete
+// One rung of the ladder against the reference.
+PrecisionRow run_rung(const PrecisionOptions& o, const Setting& s,
+                      const Trajectory& ref, const PrecisionResult& r) {
   const double simulated_s = r.ticks * r.servo_period_s;
-  for (const Setting& s : settings) {
-    const Trajectory tr = run_setting(o, s.integrator, s.step_s, r.ticks,
-                                      o.min_timing_s, o.max_repeats);
-    PrecisionRow row;
-    row.integrator = s.integrator;
-    row.step_s = s.step_s;
-    row.substeps = tr.substeps;
-    row.error = compare(tr, ref);
-    row.wall_time_s = tr.wall_time_s;
-    row.cpu_time_s = tr.cpu_time_s;
-    row.repeats = tr.repeats;
-    row.steps_per_s =
-        static_cast<double>(r.ticks) * tr.substeps / std::max(tr.wall_time_s, 1e-12);
-    row.realtime_factor = simulated_s / std::max(tr.wall_time_s, 1e-12);
-    row.is_default = s.integrator == r.default_integrator &&
-                     same_step(s.step_s, r.default_step_s);
-    row.mujoco_warnings = tr.mujoco_warnings;
-    row.local_order = kNaN;
-    r.rows.push_back(row);
-  }
+  const Trajectory tr = run_setting(o, s.integrator, s.step_s, r.ticks,
+                                    o.min_timing_s, o.max_repeats);
+  PrecisionRow row;
+  row.integrator = s.integrator;
+  row.step_s = s.step_s;
+  row.substeps = tr.substeps;
+  row.error = compare(tr, ref);
+  row.wall_time_s = tr.wall_time_s;
+  row.cpu_time_s = tr.cpu_time_s;
+  row.repeats = tr.repeats;
+  row.steps_per_s =
+      static_cast<double>(r.ticks) * tr.substeps / std::max(tr.wall_time_s, 1e-12);
+  row.realtime_factor = simulated_s / std::max(tr.wall_time_s, 1e-12);
+  row.is_default = s.integrator == r.default_integrator &&
+                   same_step(s.step_s, r.default_step_s);
+  row.mujoco_warnings = tr.mujoco_warnings;
+  row.local_order = kNaN;
+  return row;
+}
 
-  // local orders, and the fitted order over the rungs above the floor
-  for (Integrator i : o.integrators) {
+// Local orders, and the fitted order per integrator over the rungs above
+// the floor.
+void fit_orders(const std::vector<Integrator>& integrators, PrecisionResult* r) {
+  for (Integrator i : integrators) {
     std::vector<double> hs, es;
     const PrecisionRow* prev = nullptr;
-    for (PrecisionRow& row : r.rows) {
+    for (PrecisionRow& row : r->rows) {
       if (row.integrator != i) continue;
       if (prev != nullptr && row.error.finite && prev->error.finite &&
           row.error.rms_mm > 0.0 && prev->error.rms_mm > 0.0) {
@@ -392,7 +398,7 @@ PrecisionResult run_precision_study(const PrecisionOptions& o) {
                           std::log(prev->step_s / row.step_s);
       }
       prev = &row;
-      row.used_in_fit = row.error.finite && row.error.rms_mm > r.floor_mm;
+      row.used_in_fit = row.error.finite && row.error.rms_mm > r->floor_mm;
       if (row.used_in_fit) {
         hs.push_back(row.step_s);
         es.push_back(row.error.rms_mm);
@@ -400,24 +406,55 @@ PrecisionResult run_precision_study(const PrecisionOptions& o) {
     }
     OrderFit fit = fit_order(hs, es);
     fit.integrator = i;
-    r.fits.push_back(fit);
+    r->fits.push_back(fit);
   }
+}
 
+// The Pareto fronts of (wall time, error) and (CPU time, error).
+void mark_fronts(PrecisionResult* r) {
   std::vector<double> wall, cpu, err;
-  for (const PrecisionRow& row : r.rows) {
+  for (const PrecisionRow& row : r->rows) {
     wall.push_back(row.wall_time_s);
     cpu.push_back(row.cpu_time_s);
     err.push_back(row.error.finite ? row.error.rms_mm : kNaN);
   }
   const std::vector<bool> front = pareto_front(wall, err);
   const std::vector<bool> front_cpu = pareto_front(cpu, err);
-  for (std::size_t k = 0; k < r.rows.size(); ++k) {
-    r.rows[k].on_front = front[k];
-    r.rows[k].on_front_cpu = front_cpu[k];
+  for (std::size_t k = 0; k < r->rows.size(); ++k) {
+    r->rows[k].on_front = front[k];
+    r->rows[k].on_front_cpu = front_cpu[k];
   }
+}
+
+}  // namespace
+
+PrecisionResult run_precision_study(const PrecisionOptions& o) {
+  const auto study_start = Clock::now();
+  PrecisionResult r;
+  r.name = o.name;
+  r.scene = o.scene;
+  r.duration_s = o.duration_s;
+
+  // every check before the first run
+  probe_scene(o, &r);
+  r.ticks = static_cast<int>(std::llround(o.duration_s / r.servo_period_s));
+  if (r.ticks < 1) throw SimError("the study's duration is under one servo tick");
+  if (o.integrators.empty()) throw SimError("no integrator to study");
+  if (!(o.reference_step_s > 0.0) ||
+      !(o.reference_check_step_s > o.reference_step_s)) {
+    throw SimError("the reference step must be > 0 and below the check step");
+  }
+  const std::vector<Setting> settings = ladder(o, r);
+
+  const Trajectory ref = run_references(o, &r);
+  // the ladder, one run at a time, so that the timings do not compete
+  for (const Setting& s : settings) r.rows.push_back(run_rung(o, s, ref, r));
+  fit_orders(o.integrators, &r);
+  mark_fronts(&r);
 
   r.study_wall_time_s =
       std::chrono::duration<double>(Clock::now() - study_start).count();
+  if (!o.out_dir.empty()) r.files = write_precision_files(r, o.out_dir);
   return r;
 }
 
@@ -448,8 +485,8 @@ std::string precision_csv(const PrecisionResult& r) {
   return s;
 }
 
-Chart precision_chart(const PrecisionResult& r) {
-  Chart c;
+report::Chart precision_chart(const PrecisionResult& r) {
+  report::Chart c;
   char title[160];
   // centred on the plot area, so kept short
   std::snprintf(title, sizeof title, "work-precision, %.3g s, T = %.3g ms",
@@ -460,7 +497,7 @@ Chart precision_chart(const PrecisionResult& r) {
   c.x = {"wall time of the run (s)", true};
   c.y = {"RMS wrist-centre error vs RK4 reference (mm)", true};
   for (const OrderFit& f : r.fits) {
-    ChartSeries s;
+    report::ChartSeries s;
     s.label = integrator_name(f.integrator);
     s.color = colour_of(f.integrator);
     for (const PrecisionRow& row : r.rows) {
@@ -472,7 +509,7 @@ Chart precision_chart(const PrecisionResult& r) {
   }
   for (const PrecisionRow& row : r.rows) {
     if (!row.is_default || !row.error.finite) continue;
-    ChartSeries s;
+    report::ChartSeries s;
     char label[96];
     std::snprintf(label, sizeof label, "default (%s, h = %.3g ms)",
                   integrator_name(row.integrator), row.step_s * 1e3);
@@ -490,7 +527,7 @@ Chart precision_chart(const PrecisionResult& r) {
       lo = std::min(lo, row.wall_time_s);
       hi = std::max(hi, row.wall_time_s);
     }
-    ChartSeries s;
+    report::ChartSeries s;
     s.label = "reference self-error (RK4 " +
               exact(r.reference.check_step_s * 1e6) + " us vs " +
               exact(r.reference.step_s * 1e6) + " us)";
@@ -504,15 +541,15 @@ Chart precision_chart(const PrecisionResult& r) {
   return c;
 }
 
-Chart precision_order_chart(const PrecisionResult& r) {
-  Chart c;
+report::Chart precision_order_chart(const PrecisionResult& r) {
+  report::Chart c;
   c.title = "error against the physics step";
   c.width_px = 820;
   c.height_px = 480;
   c.x = {"physics step h (s)", true};
   c.y = {"RMS wrist-centre error vs RK4 reference (mm)", true};
   for (const OrderFit& f : r.fits) {
-    ChartSeries s;
+    report::ChartSeries s;
     s.color = colour_of(f.integrator);
     s.label = integrator_name(f.integrator);
     for (const PrecisionRow& row : r.rows) {
@@ -522,7 +559,7 @@ Chart precision_order_chart(const PrecisionResult& r) {
     }
     c.series.push_back(s);
     if (f.points >= 2) {
-      ChartSeries line;
+      report::ChartSeries line;
       char label[96];
       std::snprintf(label, sizeof label, "%s fit, order %.2f",
                     integrator_name(f.integrator), f.order);
@@ -541,7 +578,7 @@ Chart precision_order_chart(const PrecisionResult& r) {
     }
   }
   if (r.floor_mm > 0.0 && !r.rows.empty()) {
-    ChartSeries s;
+    report::ChartSeries s;
     s.label = "fit floor (10 x reference self-error)";
     s.color = "#7f7f7f";
     s.markers = false;
@@ -558,4 +595,4 @@ Chart precision_order_chart(const PrecisionResult& r) {
   return c;
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies

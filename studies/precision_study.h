@@ -19,6 +19,8 @@
 #ifndef VMHAPTICS_STUDIES_PRECISION_STUDY_H_
 #define VMHAPTICS_STUDIES_PRECISION_STUDY_H_
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 #include <vector>
 
@@ -26,7 +28,7 @@
 #include "sim/hand_script.h"
 #include "report/svg_chart.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 // MuJoCo 2.2.2's integrators: mjINT_EULER (semi-implicit, joint damping
 // implicit), mjINT_RK4 (needs mj_step: mj_step2 falls back to Euler), and
@@ -39,6 +41,7 @@ const char* integrator_name(Integrator i);
 bool parse_integrator(const std::string& name, Integrator* out);
 
 struct PrecisionOptions {
+  std::string name;                     // the case's name, for the JSON
   std::string scene;                    // scene file (resolve_scene)
   std::vector<std::string> overrides;   // further name=value settings
   double duration_s = 3.0;              // simulated, from the script's start
@@ -55,6 +58,9 @@ struct PrecisionOptions {
   // thread's CPU time is reported beside the wall time for the same reason)
   double min_timing_s = 0.3;
   int max_repeats = 5;
+  // where precision.csv, precision.svg and precision_order.svg go; empty:
+  // nothing is written
+  std::string out_dir;
 };
 
 // How one run differs from the reference, tick by tick.
@@ -113,11 +119,12 @@ struct ReferenceInfo {
 };
 
 struct PrecisionResult {
+  std::string name;
   std::string scene;
   double duration_s = 0.0;
   double servo_period_s = 0.0;
   int ticks = 0;
-  std::vector<ScriptSegment> segments;  // the script's, as far as the runs go
+  std::vector<sim::ScriptSegment> segments;  // the script's, as far as the runs go
   Integrator default_integrator = Integrator::kEuler;
   double default_step_s = 0.0;
   ReferenceInfo reference;
@@ -125,15 +132,17 @@ struct PrecisionResult {
   std::vector<OrderFit> fits;      // one per integrator
   double floor_mm = 0.0;           // rungs below this are not fitted
   double study_wall_time_s = 0.0;
+  std::vector<std::string> files;  // the paths written (out_dir)
 };
 
 // a rung is fitted when its rms error is above this many times the
 // reference's own error
 inline constexpr double kFloorFactor = 10.0;
 
-// Runs the study. Throws SimError on bad input (a step that does not divide
-// the servo period or is not above the reference step, a bad scene or
-// override, a duration beyond the case's), before any run.
+// Runs the study and, with out_dir, writes its files (write_precision_files).
+// Throws SimError on bad input (a step that does not divide the servo
+// period or is not above the reference step, a bad scene or override, a
+// duration beyond the case's), before any run.
 PrecisionResult run_precision_study(const PrecisionOptions& options);
 
 // The least-squares slope and intercept of log10(e) against log10(h).
@@ -149,10 +158,19 @@ std::vector<bool> pareto_front(const std::vector<double>& x,
 std::string precision_csv(const PrecisionResult& r);
 // error (RMS, mm) against wall time (s), log-log, one line per integrator,
 // the default setting and the reference marked
-Chart precision_chart(const PrecisionResult& r);
+report::Chart precision_chart(const PrecisionResult& r);
 // error (RMS, mm) against h (s), log-log, with the fitted slopes
-Chart precision_order_chart(const PrecisionResult& r);
+report::Chart precision_order_chart(const PrecisionResult& r);
 
-}  // namespace vmh::sim
+// (precision_output.cc) What the command line prints: the setting, the
+// reference, the fitted orders, the default setting against the others,
+// the Pareto front, every row, and the files written. NaN errors are null.
+nlohmann::ordered_json precision_json(const PrecisionResult& r);
+// out_dir/precision.csv, precision.svg (error against wall time) and
+// precision_order.svg (error against h); returns their paths
+std::vector<std::string> write_precision_files(const PrecisionResult& r,
+                                               const std::string& out_dir);
+
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_PRECISION_STUDY_H_

@@ -12,7 +12,9 @@
 #include "report/parallel.h"
 #include "studies/plot_svg.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace fs = std::filesystem;
 namespace {
 
@@ -230,10 +232,10 @@ CaseResult run_case(const std::string& name, const std::string& scene,
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) throw SimError(dir.string() + ": " + ec.message());
-    write_file_atomically((dir / "trace.csv").string(), trace_csv(rows, loop));
-    write_file_atomically((dir / "summary.json").string(), result.summary.dump(2) + "\n");
-    write_file_atomically((dir / "views.svg").string(), views_svg(rows, loop));
-    write_file_atomically((dir / "history.svg").string(), history_svg(rows, loop));
+    report::write_file_atomically((dir / "trace.csv").string(), trace_csv(rows, loop));
+    report::write_file_atomically((dir / "summary.json").string(), result.summary.dump(2) + "\n");
+    report::write_file_atomically((dir / "views.svg").string(), views_svg(rows, loop));
+    report::write_file_atomically((dir / "history.svg").string(), history_svg(rows, loop));
   }
   return result;
 }
@@ -241,7 +243,7 @@ CaseResult run_case(const std::string& name, const std::string& scene,
 void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
                const std::string& out_dir, int threads) {
-  parallel_for(jobs->size(), threads > 0 ? threads : core_count(),
+  report::parallel_for(jobs->size(), threads > 0 ? threads : report::core_count(),
                [&](std::size_t i) {
                  CaseJob& job = (*jobs)[i];
                  try {
@@ -255,4 +257,4 @@ void run_cases(std::vector<CaseJob>* jobs,
                });
 }
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies

@@ -13,7 +13,7 @@
 
 #include "studies/claims.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 // The thesis's six cases, in order: name and scene file under the models
 // directory. Adding a case is one line here and one file in models/cases/.
@@ -67,6 +67,6 @@ void run_cases(std::vector<CaseJob>* jobs,
 // The trace's column names, in order.
 std::vector<std::string> trace_columns(int vm_dof);
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_RUN_CASE_H_

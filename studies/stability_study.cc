@@ -11,9 +11,10 @@
 #include <stdexcept>
 
 #include "report/parallel.h"
-#include "report/svg_chart.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+// the testbed's types (sim/) by their own names in this file
+using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -477,7 +478,7 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
     }
   }
   std::vector<std::exception_ptr> errors(points.size());
-  parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
+  report::parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
     try {
       const StabilityParams& p = params[i];
       MapPoint& pt = points[i];
@@ -502,101 +503,29 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
   return points;
 }
 
-std::string stability_map_csv(const std::vector<MapPoint>& points) {
-  std::string out =
-      "virtual_damping_Ns_per_m,delay_ticks,k_crit_sim_N_per_m,"
-      "k_stable_sim_N_per_m,k_unstable_sim_N_per_m,k_crit_exact_N_per_m,"
-      "k_crit_mujoco_euler_N_per_m,k_bound_gil_N_per_m,k_passivity_N_per_m,"
-      "rel_error_sim_vs_exact,rel_error_sim_vs_gil,sim_runs\n";
-  char buf[512];
-  for (const MapPoint& p : points) {
-    std::snprintf(
-        buf, sizeof buf, "%.10g,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.6g,%.6g,%d\n",
-        p.virtual_damping_Ns_per_m, p.delay_ticks, p.sim.k_crit_N_per_m,
-        p.sim.k_stable_N_per_m, p.sim.k_unstable_N_per_m,
-        p.k_crit_exact_N_per_m, p.k_crit_mujoco_euler_N_per_m,
-        p.k_bound_gil_N_per_m, p.k_passivity_N_per_m,
-        p.sim.k_crit_N_per_m / p.k_crit_exact_N_per_m - 1.0,
-        p.sim.k_crit_N_per_m / p.k_bound_gil_N_per_m - 1.0, p.sim.runs);
-    out += buf;
+StabilityResult run_stability_study(const StabilityOptions& o) {
+  StabilityResult r;
+  r.options = o;
+  if (!r.is_map()) {
+    r.bisection = study_stability(o.model_path, o.params, o.rel_tol);
+    SliderWall probe(o.model_path, o.params);
+    r.horizon_ticks_at_k_crit = probe.horizon_ticks(r.bisection.sim.k_crit_N_per_m);
+    r.wall_time_s = r.bisection.wall_time_s;
+  } else {
+    MapSpec spec;
+    spec.base = o.params;
+    spec.virtual_damping_Ns_per_m = o.map_virtual_damping_Ns_per_m;
+    spec.delay_ticks = o.map_delay_ticks;
+    spec.rel_tol = o.rel_tol;
+    spec.jobs = o.jobs;
+    const auto t0 = std::chrono::steady_clock::now();
+    r.map = stability_map(o.model_path, spec);
+    r.wall_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
+            .count();
   }
-  return out;
+  if (!o.out_dir.empty()) r.files = write_stability_files(r, o.out_dir);
+  return r;
 }
 
-std::string stability_map_svg(const std::vector<MapPoint>& points,
-                              const StabilityParams& base) {
-  // one colour per delay; the three series of a delay share it
-  static const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c",
-                                        "#9467bd", "#ff7f0e", "#8c564b"};
-  std::vector<int> delays;
-  for (const MapPoint& p : points) {
-    if (std::find(delays.begin(), delays.end(), p.delay_ticks) ==
-        delays.end()) {
-      delays.push_back(p.delay_ticks);
-    }
-  }
-  Chart c;
-  char title[256];
-  std::snprintf(title, sizeof title,
-                "K_crit of the sampled wall: m = %g kg, b = %g N s/m, "
-                "T = %g ms, h = %g us",
-                base.mass_kg, base.damping_Ns_per_m,
-                1e3 * base.servo_period_s, 1e6 * base.physics_step_s);
-  c.title = title;
-  c.x.label = "virtual damping B (N s/m)";
-  c.y.label = "critical stiffness K_crit (N/m)";
-  c.y.min = 0.0;  // the passivity bound goes negative for B > b
-  c.width_px = 860;
-  c.height_px = 500;
-  for (std::size_t i = 0; i < delays.size(); ++i) {
-    const int n = delays[i];
-    const std::string color = kColors[i % (sizeof kColors / sizeof *kColors)];
-    const std::string tag = "n = " + std::to_string(n);
-    ChartSeries sim, exact, gil;
-    sim.label = "simulated, " + tag;
-    sim.line = false;
-    exact.label = "exact discrete, " + tag;
-    exact.markers = false;
-    gil.label = "Gil et al. (b+B)/(T/2+nT), " + tag;
-    gil.markers = false;
-    gil.dashed = true;
-    sim.color = exact.color = gil.color = color;
-    for (const MapPoint& p : points) {
-      if (p.delay_ticks != n) continue;
-      const double B = p.virtual_damping_Ns_per_m;
-      sim.x.push_back(B);
-      sim.y.push_back(p.sim.k_crit_N_per_m);
-      exact.x.push_back(B);
-      exact.y.push_back(p.k_crit_exact_N_per_m);
-      gil.x.push_back(B);
-      gil.y.push_back(p.k_bound_gil_N_per_m);
-    }
-    c.series.push_back(sim);
-    c.series.push_back(exact);
-    c.series.push_back(gil);
-  }
-  ChartSeries passive;
-  passive.label = "passivity 2(b-B)/T (Colgate & Schenkel)";
-  passive.markers = false;
-  passive.dashed = true;
-  passive.color = "#888888";
-  // where it is >= 0: up to B = b, where it reaches 0
-  double B_max = 0.0;
-  for (const MapPoint& p : points) {
-    B_max = std::max(B_max, p.virtual_damping_Ns_per_m);
-    if (p.delay_ticks != delays.front() || p.k_passivity_N_per_m < 0.0) {
-      continue;
-    }
-    passive.x.push_back(p.virtual_damping_Ns_per_m);
-    passive.y.push_back(p.k_passivity_N_per_m);
-  }
-  const double b = base.damping_Ns_per_m;
-  if (b <= B_max && (passive.x.empty() || passive.x.back() < b)) {
-    passive.x.push_back(b);
-    passive.y.push_back(0.0);
-  }
-  if (!passive.x.empty()) c.series.push_back(passive);
-  return chart_svg(c);
-}
-
-}  // namespace vmh::sim
+}  // namespace vmh::studies

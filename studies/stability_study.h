@@ -54,12 +54,15 @@
 #define VMHAPTICS_STUDIES_STABILITY_STUDY_H_
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
 #include <string>
 #include <vector>
 
+#include "report/svg_chart.h"
 #include "sim/mujoco_util.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
 
 // How the controller estimates the velocity for the damper B.
 enum class VelocityEstimate {
@@ -184,8 +187,8 @@ class SliderWall {
 
  private:
   StabilityParams p_;
-  ModelPtr m_;
-  DataPtr d_;
+  sim::ModelPtr m_;
+  sim::DataPtr d_;
   int steps_per_tick_ = 1;
 };
 
@@ -254,6 +257,50 @@ struct MapPoint {
 std::vector<MapPoint> stability_map(const std::string& model_path,
                                     const MapSpec& spec);
 
+// ---------------------------------------------------------------- the study
+
+// What `vmhaptics study stability` runs: one setting's K_crit by bisection,
+// or, when the sweep is given, the map.
+struct StabilityOptions {
+  std::string model_path;  // the slider (slider_model_path)
+  StabilityParams params;  // validated; for a map, B and n are swept
+  double rel_tol = 2e-3;   // relative width of the final K bracket
+  // a map when not empty: K_crit for every (B, n) (stability_map)
+  std::vector<double> map_virtual_damping_Ns_per_m;
+  std::vector<int> map_delay_ticks;
+  int jobs = 1;  // map points simulated at once
+  // where the CSV and the chart go (write_stability_files); empty: nothing
+  std::string out_dir;
+};
+
+struct StabilityResult {
+  StabilityOptions options;
+  StabilityReport bisection;         // one setting (not a map)
+  int horizon_ticks_at_k_crit = 0;   // the run length at the K found
+  std::vector<MapPoint> map;         // a map: by n, then B
+  double wall_time_s = 0.0;          // the bisection's, or the whole map's
+  std::vector<std::string> files;    // the paths written (out_dir)
+  bool is_map() const { return !options.map_virtual_damping_Ns_per_m.empty(); }
+};
+
+// Runs the bisection (study_stability) or the map (stability_map) and, with
+// out_dir, writes the files. Throws SimError on bad parameters.
+StabilityResult run_stability_study(const StabilityOptions& options);
+
+// ---------------------------------------------------------------- output
+// (stability_output.cc)
+
+// What the command line prints: for one setting, K_crit against the
+// theories and the relative errors; for a map, a row per (B, n) and the
+// worst relative errors. "outputs" lists the files written.
+nlohmann::ordered_json stability_json(const StabilityResult& r);
+
+// The bisection's runs, one row each: run, k_N_per_m, stable, diverged,
+// growth_rate_per_s, early_peak_m, late_peak_m, ticks.
+std::string bisection_csv(const StabilityReport& r);
+// their growth rates against K, the theories' K as vertical lines
+report::Chart bisection_chart(const StabilityReport& r);
+
 // The map as CSV, units in the column names: virtual_damping_Ns_per_m,
 // delay_ticks, k_crit_sim_N_per_m, k_stable_sim_N_per_m,
 // k_unstable_sim_N_per_m, k_crit_exact_N_per_m, k_crit_mujoco_euler_N_per_m,
@@ -261,16 +308,21 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
 // rel_error_sim_vs_gil, sim_runs.
 std::string stability_map_csv(const std::vector<MapPoint>& points);
 
-// The map as an SVG chart (sim/svg_chart.h): K_crit against B, for each
+// The map as an SVG chart (report/svg_chart.h): K_crit against B, for each
 // delay the simulated points as markers, the exact discrete boundary as a
 // line and Gil et al.'s bound dashed, with Colgate and Schenkel's passivity
 // bound dashed in grey (where it is > 0).
 std::string stability_map_svg(const std::vector<MapPoint>& points,
                               const StabilityParams& base);
 
+// out_dir/stability_bisection.csv and .svg, or for a map
+// out_dir/stability_map.csv and .svg; returns their paths
+std::vector<std::string> write_stability_files(const StabilityResult& r,
+                                               const std::string& out_dir);
+
 // The slider's model file under `models_dir`.
 std::string slider_model_path(const std::string& models_dir);
 
-}  // namespace vmh::sim
+}  // namespace vmh::studies
 
 #endif  // VMHAPTICS_STUDIES_STABILITY_STUDY_H_

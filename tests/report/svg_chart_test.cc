@@ -1,4 +1,4 @@
-// sim/svg_chart.cc: the chart is well-formed SVG, and its pixels say what
+// report/svg_chart.cc: the chart is well-formed SVG, and its pixels say what
 // the data says. Points are read back from the series' <polyline> and
 // <circle> elements and mapped against the plot area's frame
 // (<rect class="plot-area">): a point on an axis limit lands on the frame's
@@ -24,7 +24,7 @@
 
 #include "tests/support/svg_check.h"
 
-namespace vmh::sim {
+namespace vmh::report {
 namespace {
 
 using vmh::testing::count;
@@ -345,5 +345,97 @@ TEST(SvgChartTest, UnusableLimitsAreIgnoredAndNoted) {
   EXPECT_NEAR(m[1].first, f.left() + 0.5 * f.w, kPx);
 }
 
+// A band shades its x interval over the plot area's whole height, under the
+// series; a subtitle lowers the plot area by its row and carries its colour.
+TEST(SvgChartTest, BandsAndSubtitle) {
+  Chart plain;
+  plain.x = {"t (s)", false, 0.0, 10.0};
+  plain.y = {"E (mJ)", false, -1.0, 1.0};
+  plain.series.push_back(series({0, 10}, {-1, 1}));
+  Chart c = plain;
+  c.subtitle = "limit_cycle & more";
+  c.subtitle_color = "#e65100";
+  c.bands.push_back({9.0, 8.0});  // either order
+  c.bands.push_back({-5.0, 1.0});  // clamped to the plot area
+  const std::string doc = chart_svg(c);
+  save("bands", doc);
+  EXPECT_EQ(tag_problems(doc), "");
+  const Frame f = plot_area(doc), f0 = plot_area(chart_svg(plain));
+  EXPECT_NEAR(f.top(), f0.top() + 14.0, kPx);
+  EXPECT_NEAR(f.bottom(), f0.bottom(), kPx);
+  EXPECT_NE(doc.find("fill=\"#e65100\">limit_cycle &amp; more</text>"),
+            std::string::npos);
+  const std::size_t at = doc.find("<g class=\"bands\"");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_LT(at, doc.find("class=\"series\""));
+  const std::string g = doc.substr(at, doc.find("</g>", at) - at);
+  ASSERT_EQ(count(g, "<rect"), 2u);
+  const std::size_t r1 = g.find("<rect"), r2 = g.find("<rect", r1 + 1);
+  const auto a = attributes(g.substr(r1, g.find('>', r1) - r1));
+  const auto b = attributes(g.substr(r2, g.find('>', r2) - r2));
+  EXPECT_NEAR(std::stod(a.at("x")), f.left() + 0.8 * f.w, kPx);
+  EXPECT_NEAR(std::stod(a.at("width")), 0.1 * f.w, kPx);
+  EXPECT_NEAR(std::stod(a.at("y")), f.top(), kPx);
+  EXPECT_NEAR(std::stod(a.at("height")), f.h, kPx);
+  EXPECT_NEAR(std::stod(b.at("x")), f.left(), kPx);
+  EXPECT_NEAR(std::stod(b.at("width")), 0.1 * f.w, kPx);
+  // no subtitle, no band: no trace of either
+  const std::string doc0 = chart_svg(plain);
+  EXPECT_EQ(doc0.find("subtitle"), std::string::npos);
+  EXPECT_EQ(doc0.find("bands"), std::string::npos);
+}
+
+// Panels of a grid: one document, each panel a nested chart at its cell,
+// with ids of its own, laid out row by row under the title and notes.
+TEST(SvgChartTest, GridOfPanels) {
+  ChartGrid grid;
+  grid.title = "energy <per> scenario";
+  grid.notes = {"first note", "second note"};
+  grid.columns = 2;
+  for (int i = 0; i < 3; ++i) {
+    Chart c;
+    c.title = "panel " + std::to_string(i);
+    c.width_px = 300;
+    c.height_px = 200;
+    c.series.push_back(series({0, 1}, {0, 1.0 + i}, ""));
+    grid.panels.push_back(c);
+  }
+  const std::string doc = chart_grid_svg(grid);
+  save("grid", doc);
+  EXPECT_EQ(tag_problems(doc), "");
+  EXPECT_EQ(doc.rfind("<svg xmlns", 0), 0u);
+  EXPECT_NE(doc.find("class=\"chart-grid\" width=\"600.00\""), std::string::npos);
+  EXPECT_NE(doc.find(">energy &lt;per&gt; scenario</text>"), std::string::npos);
+  EXPECT_EQ(count(doc, "class=\"note\""), 2u);
+  EXPECT_EQ(count(doc, "<svg class=\"chart\""), 3u);
+  // ids are the panel's own: no two alike
+  for (int k = 0; k < 3; ++k) {
+    const std::string id = "panel-" + std::to_string(k);
+    EXPECT_EQ(count(doc, "id=\"" + id + "\""), 1u) << id;
+    EXPECT_EQ(count(doc, "id=\"" + id + "-plot-clip\""), 1u) << id;
+    EXPECT_EQ(count(doc, "url(#" + id + "-plot-clip)"), 1u) << id;
+    EXPECT_EQ(count(doc, "id=\"" + id + "-series-0\""), 1u) << id;
+  }
+  EXPECT_EQ(doc.find("id=\"series-0\""), std::string::npos);
+  // cells: the third panel starts the second row, one panel height lower
+  const auto cell = [&](int k) {
+    const std::size_t at = doc.find("id=\"panel-" + std::to_string(k) + "\"");
+    const std::size_t lt = doc.rfind('<', at);
+    return attributes(doc.substr(lt, doc.find('>', at) - lt));
+  };
+  EXPECT_DOUBLE_EQ(std::stod(cell(1).at("x")), 300.0);
+  EXPECT_DOUBLE_EQ(std::stod(cell(2).at("x")), 0.0);
+  EXPECT_DOUBLE_EQ(std::stod(cell(2).at("y")) - std::stod(cell(0).at("y")), 200.0);
+  EXPECT_GT(std::stod(cell(0).at("y")), 2 * 18.0);  // below the notes
+  // a bad panel is named
+  grid.panels[1].series.push_back(series({0}, {0, 1}, "bad"));
+  try {
+    chart_grid_svg(grid);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("panel 1"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
-}  // namespace vmh::sim
+}  // namespace vmh::report

@@ -1,7 +1,7 @@
 // The closed loop on the six thesis scenes: each steps with no MuJoCo
 // warning, holds the torque over the servo period, keeps its physics honest
-// (the hand's work matches the energy it moved), and every thesis claim holds
-// as a measured number.
+// (the hand's work matches the energy it moved). The thesis's claims on the
+// same scenes are tests/studies/claims_test.cc.
 #include "sim/closed_loop.h"
 
 #include <gtest/gtest.h>
@@ -16,22 +16,15 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
-#include "studies/claims.h"
-#include "studies/run_case.h"
 #include "tests/support/mujoco_guard.h"
+#include "tests/support/thesis_cases.h"
 
 namespace vmh::sim {
 namespace {
 
-std::string scene(int n) {
-  return std::string(VMH_MODELS_DIR) + "/cases/case" + std::to_string(n) +
-         ".xml";
-}
+std::string scene(int n) { return testing::thesis_case_scene(n); }
 
-class CaseTest : public ::testing::TestWithParam<int> {
- protected:
-  testing::MujocoGuard guard_;
-};
+using CaseTest = testing::ThesisCaseTest;
 
 // Every scene runs its whole script with no MuJoCo warning (d->warning all
 // zero, no warning callback), finite state, and no controller fault.
@@ -51,23 +44,6 @@ TEST_P(CaseTest, RunsWithoutWarningOrFault) {
     EXPECT_TRUE(std::isfinite(loop.data()->qpos[i]));
   }
   EXPECT_NEAR(loop.time_s(), 20.0, 1e-9);
-}
-
-// Each claim of the case (sim/claims.cc), measured on a full 20 s run,
-// passes; the measured figure goes in the log and the XML report.
-TEST_P(CaseTest, ThesisClaimsHold) {
-  const CaseResult r = run_case("case" + std::to_string(GetParam()),
-                                scene(GetParam()), {}, "");
-  ASSERT_FALSE(r.claims.empty());
-  for (const Claim& c : r.claims) {
-    std::printf("  case%d %-36s %.4g %s %.4g %s (%d ticks)\n", GetParam(),
-                c.name.c_str(), c.value, c.comparison.c_str(), c.threshold,
-                c.unit.c_str(), c.samples);
-    RecordProperty(c.name, std::to_string(c.value));
-    EXPECT_TRUE(c.pass) << c.name << ": " << c.value << " " << c.comparison
-                        << " " << c.threshold << " " << c.unit;
-    EXPECT_GT(c.samples, 100) << c.name << " measured on too few ticks";
-  }
 }
 
 INSTANTIATE_TEST_SUITE_P(ThesisCases, CaseTest, ::testing::Range(1, 7));

@@ -1,4 +1,4 @@
-// The stiff and extreme cases (sim/extremes_study.h), one test per scenario,
+// The stiff and extreme cases (studies/extremes_study.h), one test per scenario,
 // and the machinery they rest on: the passivity observer against an
 // independent sum, the servo jitter's draws and clock, the faults' zero
 // torque, and the two instabilities the study names.
@@ -24,7 +24,8 @@
 #include "studies/run_case.h"
 #include "tests/support/mujoco_guard.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+using namespace vmh::sim;  // NOLINT(build/namespaces): the testbed's types
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -420,4 +421,4 @@ TEST(ExtremeInstabilities, ThesisCasesComeToRest) {
 }
 
 }  // namespace
-}  // namespace vmh::sim
+}  // namespace vmh::studies

@@ -1,4 +1,4 @@
-// sim/leanness_study.cc: the scenes as composed against the same scenes with
+// studies/leanness_study.cc: the scenes as composed against the same scenes with
 // contacts, gravity and a viewer's scene update switched on.
 //
 // Performance figures are reported by `vmhaptics study leanness`, never
@@ -19,10 +19,10 @@
 
 namespace {
 
-using vmh::sim::CaseLeanness;
-using vmh::sim::LeannessOptions;
-using vmh::sim::LeannessResult;
-using vmh::sim::VariantResult;
+using vmh::studies::CaseLeanness;
+using vmh::studies::LeannessOptions;
+using vmh::studies::LeannessResult;
+using vmh::studies::VariantResult;
 
 class LeannessStudy : public ::testing::Test {
  protected:
@@ -32,7 +32,7 @@ class LeannessStudy : public ::testing::Test {
     o.scenes = {{"case1", std::string(VMH_MODELS_DIR) + "/cases/case1.xml"}};
     o.duration_s = 0.2;  // 200 ticks of the script compressed into 0.2 s
     o.repeats = 1;
-    result_ = new LeannessResult(vmh::sim::run_leanness_study(o));
+    result_ = new LeannessResult(vmh::studies::run_leanness_study(o));
     warnings_ = new std::string(guard.warnings());
   }
   static void TearDownTestSuite() {
@@ -60,7 +60,7 @@ TEST_F(LeannessStudy, EveryVariantRanEveryTick) {
   EXPECT_EQ(c.nv, 6);
   EXPECT_EQ(c.ticks, 200);
   EXPECT_EQ(c.substeps, 1);  // RK4, h = T = 1 ms (models/cases/)
-  ASSERT_EQ(c.variants.size(), vmh::sim::leanness_variants().size());
+  ASSERT_EQ(c.variants.size(), vmh::studies::leanness_variants().size());
   for (const VariantResult& v : c.variants) {
     EXPECT_GT(v.wall_time_s, 0.0) << v.variant.name;
     EXPECT_GT(v.cpu_time_s, 0.0) << v.variant.name;
@@ -129,7 +129,7 @@ TEST_F(LeannessStudy, NoFrictionlossDropsTheFrictionRows) {
 }
 
 TEST_F(LeannessStudy, TableHasOneRowPerVariant) {
-  const std::string csv = vmh::sim::leanness_csv(*result_);
+  const std::string csv = vmh::studies::leanness_csv(*result_);
   std::istringstream in(csv);
   std::string header;
   std::getline(in, header);
@@ -144,7 +144,7 @@ TEST_F(LeannessStudy, TableHasOneRowPerVariant) {
     ++lines;
     EXPECT_EQ(line.rfind("case1,", 0), 0u) << line;
   }
-  EXPECT_EQ(lines, static_cast<int>(vmh::sim::leanness_variants().size()));
+  EXPECT_EQ(lines, static_cast<int>(vmh::studies::leanness_variants().size()));
 }
 
 }  // namespace

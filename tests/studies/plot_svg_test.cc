@@ -1,4 +1,4 @@
-// sim/plot_svg.cc on real closed-loop runs (case 2: circle, case 5: sphere,
+// studies/plot_svg.cc on real closed-loop runs (case 2: circle, case 5: sphere,
 // 20 s each): the documents are well-formed SVG, the views show the two
 // snapshots the thesis shows (their times in the titles, three projections
 // for the sphere), the force arrow is the commanded force times the stated
@@ -24,7 +24,8 @@
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/svg_check.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+using namespace vmh::sim;  // NOLINT(build/namespaces): the testbed's types
 namespace {
 
 using vmh::testing::count;
@@ -271,4 +272,4 @@ TEST(PlotSvgTest, HistoryPolylinesAreDecimatedAndLabelled) {
 }
 
 }  // namespace
-}  // namespace vmh::sim
+}  // namespace vmh::studies

@@ -1,4 +1,4 @@
-// sim/precision_study.cc: the work-precision study of the closed loop.
+// studies/precision_study.cc: the work-precision study of the closed loop.
 //
 // Independent truths:
 // - the orders of the integrators: explicit/semi-implicit Euler and MuJoCo's
@@ -27,14 +27,14 @@
 
 namespace {
 
-using vmh::sim::fit_order;
-using vmh::sim::Integrator;
-using vmh::sim::OrderFit;
-using vmh::sim::pareto_front;
-using vmh::sim::PrecisionOptions;
-using vmh::sim::PrecisionResult;
-using vmh::sim::PrecisionRow;
-using vmh::sim::run_precision_study;
+using vmh::studies::fit_order;
+using vmh::studies::Integrator;
+using vmh::studies::OrderFit;
+using vmh::studies::pareto_front;
+using vmh::studies::PrecisionOptions;
+using vmh::studies::PrecisionResult;
+using vmh::studies::PrecisionRow;
+using vmh::studies::run_precision_study;
 
 const std::string kModels = VMH_MODELS_DIR;
 const std::string kSmoothScene = VMH_TEST_SCENES_DIR "/case1_smooth.xml";
@@ -57,7 +57,7 @@ const OrderFit& fit_of(const PrecisionResult& r, Integrator i) {
   for (const OrderFit& f : r.fits) {
     if (f.integrator == i) return f;
   }
-  ADD_FAILURE() << "no fit for " << vmh::sim::integrator_name(i);
+  ADD_FAILURE() << "no fit for " << vmh::studies::integrator_name(i);
   return r.fits.front();
 }
 
@@ -181,7 +181,7 @@ TEST(PrecisionStudy, CaseOneAsComposed) {
     const auto e = errors_of(r, i);  // ascending h
     double previous = 0.0;
     for (const auto& [h, err] : e) {
-      EXPECT_GT(err, previous) << vmh::sim::integrator_name(i) << " h " << h;
+      EXPECT_GT(err, previous) << vmh::studies::integrator_name(i) << " h " << h;
       previous = err;
     }
   }
@@ -196,7 +196,7 @@ TEST(PrecisionStudy, CaseOneAsComposed) {
   EXPECT_EQ(guard.warnings(), "");
 
   // the table: a header with units and one line per row
-  const std::string csv = vmh::sim::precision_csv(r);
+  const std::string csv = vmh::studies::precision_csv(r);
   std::istringstream in(csv);
   std::string header;
   std::getline(in, header);
@@ -214,7 +214,7 @@ TEST(PrecisionStudy, CaseOneAsComposed) {
   EXPECT_EQ(lines, static_cast<int>(r.rows.size()));
 
   // the chart: one line per integrator, then the default's marker
-  const vmh::sim::Chart chart = vmh::sim::precision_chart(r);
+  const vmh::report::Chart chart = vmh::studies::precision_chart(r);
   ASSERT_GE(chart.series.size(), 4u);
   EXPECT_TRUE(chart.x.log);
   EXPECT_TRUE(chart.y.log);

@@ -1,4 +1,4 @@
-// sim/stability_study.cc: the critical stiffness of the sampled-data wall,
+// studies/stability_study.cc: the critical stiffness of the sampled-data wall,
 // found by simulating the slider in MuJoCo, against theory (docs/sources.md
 // §11):
 //   - Gil et al. 2004: K_crit = (b + B)/(T/2 + n T), within 5%, where that
@@ -24,7 +24,8 @@
 #include "report/svg_chart.h"
 #include "tests/support/mujoco_guard.h"
 
-namespace vmh::sim {
+namespace vmh::studies {
+using namespace vmh::sim;  // NOLINT(build/namespaces): the testbed's types
 namespace {
 
 const std::string kModel = std::string(VMH_MODELS_DIR) + "/slider/slider.xml";
@@ -433,4 +434,4 @@ TEST(StabilityStudyTest, MapTableAndChart) {
 }
 
 }  // namespace
-}  // namespace vmh::sim
+}  // namespace vmh::studies
