@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -17,8 +18,10 @@
 #include <type_traits>
 #include <utility>
 
+#include "controller/controller.h"
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "device/servo_tick.h"
 #include "tests/support/alloc_counter.h"
 #include "tests/support/scripted_device.h"
 
@@ -638,6 +641,59 @@ TEST(SafetyLayer, WatchdogZeroesTheDeviceAndTheServoRampsBack) {
   rig.layer.set_read_time(t + kDt);
   EXPECT_LT((rig.tick(kSmall) - 0.1 * kSmall).norm(), 1e-15);
   EXPECT_FALSE(rig.layer.service_watchdog(t + kDt + 1e-3));
+}
+
+TEST(SafetyLayer, LimitsStillHoldWhenThePoseChangesUnderTheRateLimiter) {
+  // the torque held by the rate limiter makes more force at a pose nearer
+  // the shoulder axis; the final clamp keeps the force limit there too
+  SafetyParams p = quiet();
+  p.max_force_N = 1.0;
+  p.max_force_step_N = 0.05;
+  p.motor_torque_limit_Nm = {10.0, 10.0, 10.0};
+  Rig rig(p);
+  const Vec3 F(1.0, 0.0, 0.0);  // along device x: the waist motor's work
+  const Vec3 tau = torque_for_force(pose_dh(), 3.0 * F);
+  for (int k = 0; k < 40; ++k) rig.tick(tau);
+  ASSERT_NEAR(force_for_torque(pose_dh(), rig.dev.written).norm(), 1.0, 1e-6);
+  // reach toward the joint-1 axis: the same waist torque is a larger force
+  Joints near_axis = pose_dh();
+  near_axis[1] = 1.2;
+  near_axis[2] = 0.2;
+  rig.dev.q = dh_to_device_joints(near_axis);
+  ASSERT_GT(force_for_torque(near_axis, rig.dev.written).norm(), 1.05);
+  const Vec3 out = rig.tick(tau);
+  EXPECT_LE(force_for_torque(near_axis, out).norm(), 1.0 + 1e-6);
+  EXPECT_TRUE(rig.layer.status() & kSafetyForceClamped);
+}
+
+// the chain of docs/safety.md, with the project's controller behind it
+TEST(SafetyLayer, ServoTickThroughTheLayer) {
+  ControllerParams cp;
+  cp.gains.k_ornt_Nmm_per_rad = thesis_orientation_gain(0.5, 50.0);
+  Controller controller(cp), reference(cp);
+  ScriptedDevice dev;
+  SafetyParams p = quiet();
+  p.ramp_s = 0.01;
+  SafetyLayer layer(&dev, p);
+  const Joints t = (Joints() << -0.1, 0.4, 0.1, -0.2, 0.3, 0.1).finished();
+  dev.q = t;
+  ControlOutput out, ref;
+  for (int k = 0; k <= 12; ++k) {
+    const ServoTickResult r = servo_tick(&layer, &controller, &out);
+    ASSERT_EQ(r.read, DeviceError::kOk);
+    reference.tick(device_to_dh_joints(t), &ref);
+    ASSERT_GT(ref.tau_motor_Nm.norm(), 1e-3);
+    ASSERT_LT(ref.force_device_N.norm(), p.max_force_N);
+    const double s = std::min(1.0, k / 10.0);
+    EXPECT_LT((dev.written - s * ref.tau_motor_Nm).norm(), 1e-12) << k;
+  }
+  // the layer's torque-to-force map agrees with the controller's own
+  EXPECT_LT((layer.force_device_N(out.tau_motor_Nm) - out.force_device_N).norm(),
+            1e-6 * (1.0 + out.force_device_N.norm()));
+  // a failed read reaches the device as zero through both
+  dev.read_error = DeviceError::kTimeout;
+  EXPECT_TRUE(servo_tick(&layer, &controller, &out).zeroed);
+  EXPECT_EQ(dev.written, Vec3::Zero());
 }
 
 TEST(SafetyLayer, ServoPathAllocatesNothing) {
