@@ -193,6 +193,9 @@ DeviceError SafetyLayer::read_joints(Joints* q_device_rad) noexcept {
     }
   }
 
+  // the motors held the last torque over the interval that just ended
+  update_heat(tau_prev_);
+
   Joints q;
   DeviceError err = inner_->read_joints(&q);
   if (err == DeviceError::kOk && !q.allFinite()) err = DeviceError::kSensorFault;
@@ -271,8 +274,8 @@ double SafetyLayer::clamp_factor(const Vec3& tau) const noexcept {
 }
 
 void SafetyLayer::update_heat(const Vec3& tau) noexcept {
-  // exact solution over one step of dh/dt = (u - h)/T with u = (tau/tau_c)^2
-  // held constant over the step (the device holds the torque)
+  // exact solution over one interval dt_s_ of dh/dt = (u - h)/T with
+  // u = (tau/tau_c)^2, tau the torque the device held over it
   const double decay = std::exp(-dt_s_ / params_.thermal_time_constant_s);
   for (int i = 0; i < 3; ++i) {
     const double r = tau[i] / tau_cont_[i];
@@ -302,7 +305,6 @@ DeviceError SafetyLayer::write_motor_torques(const Vec3& tau_motor_Nm) noexcept 
 
   if ((status_ & kSafetyCuts) != 0) {
     cut_state();
-    update_heat(Vec3::Zero());
     const DeviceError err = inner_->write_motor_torques(Vec3::Zero());
     return finite ? err : DeviceError::kInvalidCommand;
   }
@@ -348,7 +350,6 @@ DeviceError SafetyLayer::write_motor_torques(const Vec3& tau_motor_Nm) noexcept 
   // limits hold after the rate limiter too
   tau *= clamp_factor(tau);
 
-  update_heat(tau);
   tau_prev_ = tau;
   return inner_->write_motor_torques(tau);
 }

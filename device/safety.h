@@ -193,7 +193,9 @@ class SafetyLayer final : public HapticDevice {
   SafetyStatus status() const noexcept { return status_; }
   // The torque last sent to the inner device, N m
   const Vec3& last_torque_Nm() const noexcept { return tau_prev_; }
-  // Thermal state per motor, (continuous torque)^2 units
+  // Thermal state per motor, (continuous torque)^2 units, as of the last
+  // read (each read adds the interval since the previous one, over which
+  // the motors held the last torque sent)
   const Vec3& thermal_state() const noexcept { return heat_; }
   // Each motor's continuous torque, N m (the thermal model's unit)
   const Vec3& continuous_torque_Nm() const noexcept { return tau_cont_; }

@@ -99,8 +99,14 @@ struct Rig {
   // one servo tick: read, then write the command; returns what reached the
   // device
   Vec3 tick(const Vec3& tau) {
+    read_only();
+    return write_only(tau);
+  }
+  void read_only() {
     Joints q;
     read = layer.read_joints(&q);
+  }
+  Vec3 write_only(const Vec3& tau) {
     write = layer.write_motor_torques(tau);
     return dev.written;
   }
@@ -448,8 +454,9 @@ TEST(SafetyThermal, DeratesLinearlyAndSettlesWhereHeatingMeetsCooling) {
   const double r = 1.6;
   const Vec3 tau(r * rig.layer.continuous_torque_Nm()[0], 0.0, 0.0);
   for (int n = 0; n < 10000; ++n) {  // 20 time constants
+    rig.read_only();
     const double h = rig.layer.thermal_state().maxCoeff();  // what write n sees
-    const Vec3 out = rig.tick(tau);
+    const Vec3 out = rig.write_only(tau);
     const double x = std::max(0.0, (h - 1.2) / (2.0 - 1.2));
     ASSERT_NEAR(out[0] / tau[0], 1.0 - 0.5 * x, 1e-12) << "write " << n;
     ASSERT_EQ((rig.layer.status() & kSafetyMotorWarm) != 0, h > 1.2);
@@ -466,6 +473,28 @@ TEST(SafetyThermal, DeratesLinearlyAndSettlesWhereHeatingMeetsCooling) {
   EXPECT_EQ(rig.layer.status(), kSafetyOk);
 }
 
+TEST(SafetyThermal, HeatsOverAStampedGapWithTheTorqueHeldThrough) {
+  // each read adds the interval since the last one, at the torque the
+  // device held over it: a 0.5 s gap heats by u (1 - e^(-0.5/T))
+  SafetyParams p = quiet();
+  p.thermal_time_constant_s = 1.0;
+  Rig rig(p);
+  const double r = 1.6, u = r * r;
+  const Vec3 tau(r * rig.layer.continuous_torque_Nm()[0], 0.0, 0.0);
+  rig.layer.set_read_time(10.0);
+  EXPECT_EQ(rig.tick(tau), tau);
+  EXPECT_EQ(rig.layer.thermal_state()[0], 0.0);  // nothing held before
+  rig.layer.set_read_time(10.5);
+  rig.read_only();
+  const double h1 = u * (1.0 - std::exp(-0.5));
+  EXPECT_NEAR(rig.layer.thermal_state()[0], h1, 1e-12);
+  EXPECT_EQ(rig.write_only(Vec3::Zero()), Vec3::Zero());
+  rig.layer.set_read_time(11.5);
+  rig.read_only();
+  EXPECT_NEAR(rig.layer.thermal_state()[0], h1 * std::exp(-1.0), 1e-12);
+  EXPECT_EQ(rig.layer.thermal_state()[1], 0.0);
+}
+
 TEST(SafetyThermal, ALargeOverloadIsCutDespiteDerating) {
   // u d_cut^2 > cut: the derated torque still heats past the cut
   SafetyParams p = quiet();
@@ -477,8 +506,9 @@ TEST(SafetyThermal, ALargeOverloadIsCutDespiteDerating) {
   int n = 0;
   double x_max = 0.0;
   for (; n < 20000; ++n) {
+    rig.read_only();
     const double h = rig.layer.thermal_state().maxCoeff();  // what write n sees
-    const Vec3 out = rig.tick(tau);
+    const Vec3 out = rig.write_only(tau);
     if (out == Vec3::Zero()) {
       EXPECT_GE(h, p.thermal_cut);
       break;
