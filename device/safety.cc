@@ -119,13 +119,14 @@ SafetyLayer::SafetyLayer(HapticDevice* inner, const SafetyParams& params,
     : inner_(inner),
       params_(params),
       omni_(omni),
+      // a placeholder until the parameters are validated, so that a bad
+      // period or count is reported by the field's name
       watchdog_(1.0, 1),
       dt_s_(params.servo_period_s) {
   if (inner_ == nullptr) throw std::invalid_argument("SafetyLayer: no device");
   params_.validate();
   omni_.validate();
   watchdog_ = ServoWatchdog(params_.servo_period_s, params_.watchdog_periods);
-  dt_s_ = params_.servo_period_s;
   // continuous torque of each motor: the largest torque a continuous force
   // in any direction needs at the nominal pose (DH q = 0, arms orthogonal).
   // tau_motor = D J_v^T F_base, so motor i's worst case is |row i| |F|.

@@ -205,7 +205,7 @@ class SafetyLayer final : public HapticDevice {
   double tip_speed_m_s() const noexcept { return tip_speed_; }
   double joint_speed_rad_s() const noexcept { return joint_speed_; }
   // Device-frame force (N) at the wrist centre that motor torques make at
-  // the pose of the last good read
+  // the pose of the last good read (zero before the first one)
   Vec3 force_device_N(const Vec3& tau_motor_Nm) const noexcept;
 
  private:
