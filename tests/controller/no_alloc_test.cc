@@ -17,6 +17,7 @@
 
 #include "controller/controller.h"
 #include "controller/device_frame.h"
+#include "device/safety.h"
 #include "device/servo_tick.h"
 #include "controller/omni_kinematics.h"
 #include "tests/support/alloc_counter.h"
@@ -249,6 +250,44 @@ TEST(NoAlloc, ServoTick) {
   // the error paths were taken: 12 failed reads, 9 failed writes and one
   // NaN per mechanism (some may coincide)
   EXPECT_GE(zeroed, 2 * 12);
+}
+
+// the same through the safety layer, Eigen's malloc forbidden and its
+// assertions live: random readings (velocity cuts), failed reads (comm
+// loss), slow and fast slews of the pose, every limit in play
+TEST(NoAlloc, ServoTickThroughTheSafetyLayer) {
+  ControllerParams p;
+  p.gains.k_ornt_Nmm_per_rad = thesis_orientation_gain(0.5, 50.0);
+  Controller c(p);
+  ScriptedDevice dev;
+  SafetyParams sp;
+  sp.comm_lost_reads = 2;
+  sp.comm_resume_reads = 5;
+  sp.ramp_s = 0.01;
+  SafetyLayer layer(&dev, sp);
+  ControlOutput out;
+  std::vector<Joints> qs = random_configurations(400);
+  std::size_t allocations = 0;
+  int cut = 0;
+  {
+    NoEigenMalloc guard;
+    AllocationScope scope;
+    for (std::size_t k = 0; k < qs.size(); ++k) {
+      // long runs of one pose (force flows) between jumps (velocity cuts)
+      dev.q_device = qs[(k / 40) * 40];
+      dev.read_error = k % 41 == 7 ? DeviceError::kIo : DeviceError::kOk;
+      layer.set_read_time(1e-3 * static_cast<double>(k));
+      layer.set_inputs(k % 97 == 0, true);
+      EXPECT_NO_THROW(servo_tick(&layer, &c, &out));
+      layer.service_watchdog(1e-3 * static_cast<double>(k));
+      if ((layer.status() & kSafetyCuts) != 0) ++cut;
+    }
+    allocations = scope.count();
+  }
+  EXPECT_EQ(allocations, 0u);
+  // both paths were taken
+  EXPECT_GT(cut, 10);
+  EXPECT_LT(cut, 300);
 }
 
 }  // namespace

@@ -1,0 +1,358 @@
+#include "device/safety.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "controller/device_frame.h"
+#include "controller/omni_kinematics.h"
+
+namespace vmh {
+
+const char* safety_flag_name(SafetyStatus flag) {
+  switch (flag) {
+    case kSafetyOk: return "ok";
+    case kSafetyForceClamped: return "force_clamped";
+    case kSafetyTorqueClamped: return "torque_clamped";
+    case kSafetyForceRamping: return "force_ramping";
+    case kSafetyForceImpulseLimited: return "force_impulse_limited";
+    case kSafetyVelocityExceeded: return "velocity_exceeded";
+    case kSafetyMotorWarm: return "motor_warm";
+    case kSafetyMotorHot: return "motor_hot";
+    case kSafetyWatchdogExpired: return "watchdog_expired";
+    case kSafetyCommLost: return "comm_lost";
+    case kSafetyDocked: return "docked";
+    case kSafetyDeadmanReleased: return "deadman_released";
+    case kSafetyForceOutputOff: return "force_output_off";
+    case kSafetyNoReading: return "no_reading";
+    case kSafetyInvalidCommand: return "invalid_command";
+    default: return "unknown";
+  }
+}
+
+namespace {
+
+void require(bool ok, const char* field, const char* what) {
+  if (!ok) {
+    throw std::invalid_argument(std::string("SafetyParams: ") + field + " " +
+                                what);
+  }
+}
+
+bool positive(double v) { return std::isfinite(v) && v > 0.0; }
+
+// J_v, the linear rows of the wrist-centre Jacobian, DH base frame, m/rad
+Mat3 linear_jacobian(const OmniParams& omni, const Joints& q_dh) {
+  return omni_jacobian(omni, q_dh).topLeftCorner<3, 3>();
+}
+
+// the matrix of a linear map Vec3 -> Vec3 given as a function
+template <typename F>
+Mat3 matrix_of(F f) {
+  Mat3 m;
+  for (int i = 0; i < 3; ++i) m.col(i) = f(Vec3::Unit(i));
+  return m;
+}
+
+}  // namespace
+
+void SafetyParams::validate() const {
+  require(positive(servo_period_s), "servo_period_s", "must be > 0");
+  require(positive(max_force_N), "max_force_N", "must be > 0");
+  for (double lim : motor_torque_limit_Nm) {
+    require(positive(lim), "motor_torque_limit_Nm", "must be > 0");
+  }
+  require(std::isfinite(singular_damping_m) && singular_damping_m >= 0.0,
+          "singular_damping_m", "must be >= 0");
+  require(std::isfinite(ramp_s) && ramp_s >= 0.0, "ramp_s", "must be >= 0");
+  require(positive(max_force_step_N), "max_force_step_N", "must be > 0");
+  require(positive(max_tip_speed_m_s), "max_tip_speed_m_s", "must be > 0");
+  require(positive(resume_tip_speed_m_s) &&
+              resume_tip_speed_m_s < max_tip_speed_m_s,
+          "resume_tip_speed_m_s", "must be in (0, max_tip_speed_m_s)");
+  require(positive(max_joint_speed_rad_s), "max_joint_speed_rad_s",
+          "must be > 0");
+  require(positive(resume_joint_speed_rad_s) &&
+              resume_joint_speed_rad_s < max_joint_speed_rad_s,
+          "resume_joint_speed_rad_s", "must be in (0, max_joint_speed_rad_s)");
+  require(positive(continuous_force_N), "continuous_force_N", "must be > 0");
+  require(positive(thermal_time_constant_s), "thermal_time_constant_s",
+          "must be > 0");
+  require(positive(thermal_cut), "thermal_cut", "must be > 0");
+  require(positive(thermal_warn) && thermal_warn < thermal_cut, "thermal_warn",
+          "must be in (0, thermal_cut)");
+  require(positive(thermal_resume) && thermal_resume < thermal_cut,
+          "thermal_resume", "must be in (0, thermal_cut)");
+  require(positive(derate_at_cut) && derate_at_cut <= 1.0, "derate_at_cut",
+          "must be in (0, 1]");
+  require(comm_lost_reads >= 1, "comm_lost_reads", "must be >= 1");
+  require(comm_resume_reads >= 1, "comm_resume_reads", "must be >= 1");
+  require(watchdog_periods >= 1, "watchdog_periods", "must be >= 1");
+}
+
+ServoWatchdog::ServoWatchdog(double servo_period_s, int periods) {
+  if (!positive(servo_period_s)) {
+    throw std::invalid_argument("ServoWatchdog: servo_period_s must be > 0");
+  }
+  if (periods < 1) {
+    throw std::invalid_argument("ServoWatchdog: periods must be >= 1");
+  }
+  timeout_s_ = servo_period_s * periods;
+}
+
+void ServoWatchdog::kick(double now_s) noexcept {
+  if (!std::isfinite(now_s)) return;
+  last_kick_s_ = now_s;
+  armed_ = true;
+}
+
+bool ServoWatchdog::expired(double now_s) const noexcept {
+  if (!armed_) return false;
+  // a non-finite clock is treated as expired: the safe answer
+  if (!std::isfinite(now_s)) return true;
+  return now_s - last_kick_s_ > timeout_s_;
+}
+
+SafetyLayer::SafetyLayer(HapticDevice* inner, const SafetyParams& params,
+                         const OmniParams& omni)
+    : inner_(inner),
+      params_(params),
+      omni_(omni),
+      // a placeholder until the parameters are validated, so that a bad
+      // period or count is reported by the field's name
+      watchdog_(1.0, 1),
+      dt_s_(params.servo_period_s) {
+  if (inner_ == nullptr) throw std::invalid_argument("SafetyLayer: no device");
+  params_.validate();
+  omni_.validate();
+  watchdog_ = ServoWatchdog(params_.servo_period_s, params_.watchdog_periods);
+  // continuous torque of each motor: the largest torque a continuous force
+  // in any direction needs at the nominal pose (DH q = 0, arms orthogonal).
+  // tau_motor = D J_v^T F_base, so motor i's worst case is |row i| |F|.
+  const Mat3 D = matrix_of([](const Vec3& v) { return dh_to_motor_torques(v); });
+  const Mat3 DJt = D * linear_jacobian(omni_, Joints::Zero()).transpose();
+  for (int i = 0; i < 3; ++i) {
+    tau_cont_[i] = params_.continuous_force_N * DJt.row(i).norm();
+    if (!positive(tau_cont_[i])) {
+      throw std::invalid_argument(
+          "SafetyLayer: a motor takes no torque at the nominal pose");
+    }
+  }
+}
+
+Vec3 SafetyLayer::force_device_N(const Vec3& tau_motor_Nm) const noexcept {
+  return torque_to_force_ * tau_motor_Nm;
+}
+
+void SafetyLayer::set_read_time(double now_s) noexcept {
+  stamp_s_ = now_s;
+  stamped_ = true;
+}
+
+void SafetyLayer::set_inputs(bool docked, bool deadman_pressed) noexcept {
+  docked_ = docked;
+  deadman_ = deadman_pressed;
+}
+
+void SafetyLayer::set_force_output(bool on) noexcept {
+  if (on && !force_on_) {
+    ramp_elapsed_s_ = 0.0;
+    ramp_running_ = false;
+  }
+  force_on_ = on;
+}
+
+void SafetyLayer::cut_state() noexcept {
+  tau_prev_.setZero();
+  ramp_elapsed_s_ = 0.0;
+  ramp_running_ = false;
+  ramp_scale_ = 0.0;
+}
+
+bool SafetyLayer::service_watchdog(double now_s) noexcept {
+  if (!watchdog_.expired(now_s)) return false;
+  watchdog_fired_ = true;
+  status_ |= kSafetyWatchdogExpired;
+  cut_state();
+  (void)inner_->write_motor_torques(Vec3::Zero());
+  return true;
+}
+
+DeviceError SafetyLayer::read_joints(Joints* q_device_rad) noexcept {
+  status_ = kSafetyOk;
+  // the time step since the last read: stamped, or one servo period
+  dt_s_ = params_.servo_period_s;
+  if (stamped_) {
+    if (have_stamp_ && std::isfinite(stamp_s_ - last_stamp_s_) &&
+        stamp_s_ > last_stamp_s_) {
+      dt_s_ = stamp_s_ - last_stamp_s_;
+    }
+    if (std::isfinite(stamp_s_)) {
+      last_stamp_s_ = stamp_s_;
+      have_stamp_ = true;
+    }
+  }
+
+  // the motors held the last torque over the interval that just ended
+  update_heat(tau_prev_);
+
+  Joints q;
+  DeviceError err = inner_->read_joints(&q);
+  if (err == DeviceError::kOk && !q.allFinite()) err = DeviceError::kSensorFault;
+  if (err != DeviceError::kOk) {
+    have_reading_ = false;
+    have_previous_ = false;  // nothing to take a velocity from
+    good_reads_ = 0;
+    if (++failed_reads_ >= params_.comm_lost_reads) comm_lost_ = true;
+    if (comm_lost_) status_ |= kSafetyCommLost;
+    if (watchdog_fired_) status_ |= kSafetyWatchdogExpired;
+    return err;
+  }
+  failed_reads_ = 0;
+  // the ramp's clock: the time from the write that started it to this read
+  if (ramp_running_) {
+    ramp_elapsed_s_ = std::min(ramp_elapsed_s_ + dt_s_, params_.ramp_s);
+  }
+  if (comm_lost_ && ++good_reads_ >= params_.comm_resume_reads) {
+    comm_lost_ = false;
+    good_reads_ = 0;
+  }
+  if (comm_lost_) status_ |= kSafetyCommLost;
+  // the servo is ticking again: the watchdog's cut ends (the ramp restarts
+  // because the watchdog zeroed the state)
+  watchdog_fired_ = false;
+
+  const Joints q_dh = device_to_dh_joints(q);
+  const Vec3 p_m = omni_fk(omni_, q_dh).p_base_m;
+  const Mat3 J = linear_jacobian(omni_, q_dh);
+  // F_base solves J^T F = tau_dh; damped least squares keeps it finite at a
+  // singularity: F = (J J^T + l^2 I)^-1 J tau_dh
+  const double l2 = params_.singular_damping_m * params_.singular_damping_m;
+  const Mat3 JJt = J * J.transpose() + l2 * Mat3::Identity();
+  const Mat3 M = matrix_of([](const Vec3& v) { return motor_to_dh_torques(v); });
+  torque_to_force_ = R_device_base() * JJt.inverse() * J * M;
+  if (!torque_to_force_.allFinite()) {
+    // cannot happen for finite angles and l > 0; a cut is the safe answer
+    have_reading_ = false;
+    have_previous_ = false;
+    return DeviceError::kSensorFault;
+  }
+
+  tip_speed_ = 0.0;
+  joint_speed_ = 0.0;
+  if (have_previous_) {
+    tip_speed_ = (p_m - p_prev_m_).norm() / dt_s_;
+    joint_speed_ = (q.head<3>() - q_prev_.head<3>()).cwiseAbs().maxCoeff() / dt_s_;
+    if (tip_speed_ > params_.max_tip_speed_m_s ||
+        joint_speed_ > params_.max_joint_speed_rad_s) {
+      velocity_exceeded_ = true;
+    } else if (tip_speed_ < params_.resume_tip_speed_m_s &&
+               joint_speed_ < params_.resume_joint_speed_rad_s) {
+      velocity_exceeded_ = false;
+    }
+  }
+  if (velocity_exceeded_) status_ |= kSafetyVelocityExceeded;
+  q_prev_ = q;
+  p_prev_m_ = p_m;
+  have_previous_ = true;
+  have_reading_ = true;
+  *q_device_rad = q;
+  return DeviceError::kOk;
+}
+
+double SafetyLayer::clamp_factor(const Vec3& tau) const noexcept {
+  double s = 1.0;
+  for (int i = 0; i < 3; ++i) {
+    const double a = std::abs(tau[i]);
+    if (a > params_.motor_torque_limit_Nm[i]) {
+      s = std::min(s, params_.motor_torque_limit_Nm[i] / a);
+    }
+  }
+  const double f = force_device_N(tau).norm();
+  if (f > params_.max_force_N) s = std::min(s, params_.max_force_N / f);
+  return s;
+}
+
+void SafetyLayer::update_heat(const Vec3& tau) noexcept {
+  // exact solution over one interval dt_s_ of dh/dt = (u - h)/T with
+  // u = (tau/tau_c)^2, tau the torque the device held over it
+  const double decay = std::exp(-dt_s_ / params_.thermal_time_constant_s);
+  for (int i = 0; i < 3; ++i) {
+    const double r = tau[i] / tau_cont_[i];
+    const double u = r * r;
+    heat_[i] = u + (heat_[i] - u) * decay;
+  }
+}
+
+DeviceError SafetyLayer::write_motor_torques(const Vec3& tau_motor_Nm) noexcept {
+  // keep the read's flags (velocity, comm); recompute the rest
+  status_ &= (kSafetyVelocityExceeded | kSafetyCommLost | kSafetyWatchdogExpired);
+  if (stamped_ && std::isfinite(stamp_s_)) watchdog_.kick(stamp_s_);
+  stamped_ = false;
+
+  const double hottest = heat_.maxCoeff();
+  if (hot_ && hottest <= params_.thermal_resume) hot_ = false;
+  if (hottest >= params_.thermal_cut) hot_ = true;
+
+  const bool finite = tau_motor_Nm.allFinite();
+  if (!finite) status_ |= kSafetyInvalidCommand;
+  if (!force_on_) status_ |= kSafetyForceOutputOff;
+  if (!have_reading_) status_ |= kSafetyNoReading;
+  if (docked_) status_ |= kSafetyDocked;
+  if (params_.require_deadman && !deadman_) status_ |= kSafetyDeadmanReleased;
+  if (hot_) status_ |= kSafetyMotorHot;
+  have_reading_ = false;  // each write needs a fresh reading
+
+  if ((status_ & kSafetyCuts) != 0) {
+    cut_state();
+    const DeviceError err = inner_->write_motor_torques(Vec3::Zero());
+    return finite ? err : DeviceError::kInvalidCommand;
+  }
+
+  // clamps: one factor keeps the direction of the torques and the force
+  Vec3 tau = tau_motor_Nm;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(tau[i]) > params_.motor_torque_limit_Nm[i]) {
+      status_ |= kSafetyTorqueClamped;
+    }
+  }
+  if (force_device_N(tau).norm() > params_.max_force_N) {
+    status_ |= kSafetyForceClamped;
+  }
+  tau *= clamp_factor(tau);
+
+  // thermal derating, linear from 1 at warn to derate_at_cut at cut
+  if (hottest > params_.thermal_warn) {
+    status_ |= kSafetyMotorWarm;
+    const double x = (hottest - params_.thermal_warn) /
+                     (params_.thermal_cut - params_.thermal_warn);
+    tau *= 1.0 - (1.0 - params_.derate_at_cut) * std::min(x, 1.0);
+  }
+
+  // ramp: the scale is (time since the write that started it) / ramp_s,
+  // k dt / ramp_s at the k-th write at a steady period
+  ramp_scale_ = params_.ramp_s > 0.0
+                    ? std::min(1.0, ramp_elapsed_s_ / params_.ramp_s)
+                    : 1.0;
+  if (ramp_scale_ < 1.0) status_ |= kSafetyForceRamping;
+  tau *= ramp_scale_;
+  ramp_running_ = true;
+
+  // impulse: the change of torque is scaled (direction kept) so that the
+  // change of force it makes at this pose is at most max_force_step_N
+  const Vec3 dtau = tau - tau_prev_;
+  const double df = force_device_N(dtau).norm();
+  if (df > params_.max_force_step_N) {
+    status_ |= kSafetyForceImpulseLimited;
+    tau = tau_prev_ + dtau * (params_.max_force_step_N / df);
+  }
+  // the previous torque may exceed the force limit at the new pose: the
+  // limits hold after the rate limiter too
+  tau *= clamp_factor(tau);
+
+  tau_prev_ = tau;
+  return inner_->write_motor_torques(tau);
+}
+
+}  // namespace vmh
