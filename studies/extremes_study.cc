@@ -28,25 +28,17 @@ std::string vec_text(const Vec3& v) {
   return buf;
 }
 
-// a field's default from the case table, as a vector
-Vec3 default_vec3(const char* name) {
-  for (const FieldSpec& f : case_fields()) {
-    if (std::string(f.name) != name) continue;
-    std::istringstream in(f.default_value);
-    Vec3 v;
-    in >> v.x() >> v.y() >> v.z();
-    return v;
-  }
-  throw SimError(std::string("no case field ") + name);
-}
-
 // The start point of the circle cases (pivot at the origin, L = 50 mm, the
 // default script_dir projected on the device x-y plane), and the forearm's
 // direction there (z4 of Table B.1: elbow to wrist centre, device frame) on
 // the IK branch nearest the home pose. With q5 = +pi/2 the stylus axis z6 is
 // -z4: the pen continues the forearm, tip away from the elbow.
 Vec3 circle_start_mm() {
-  Vec3 dir = default_vec3("script_dir");
+  // the table's defaults, typed: a circle scene that sets nothing else
+  const sim::CaseParams defaults = sim::load_case_params(
+      "the case table's defaults",
+      {{"vm_kind", "circle", sim::ValueSource::kScene, "defaults"}});
+  Vec3 dir = defaults.script.dir;
   dir.z() = 0.0;
   return 50.0 * dir.normalized();
 }
