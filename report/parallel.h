@@ -1,7 +1,7 @@
 // Independent runs (cases, scenarios, map points) spread over threads. Each
-// run builds its own model and data; ClosedLoop finds its hand through a
-// thread-local pointer and model loading is serialised (mujoco_util.h), so
-// runs on different threads do not disturb each other.
+// run builds its own model and data; each loop's hand is registered for its
+// own mjData (sim/hand.h) and model loading is serialised (mujoco_util.h),
+// so runs on different threads do not disturb each other.
 #ifndef VMHAPTICS_REPORT_PARALLEL_H_
 #define VMHAPTICS_REPORT_PARALLEL_H_
 

@@ -472,8 +472,8 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
     fs::create_directories(fs::path(o.out_dir) / "extremes", ec);
     if (ec) throw SimError(o.out_dir + ": " + ec.message());
   }
-  // the scenarios are independent: run them on `jobs` threads (ClosedLoop
-  // finds its hand through a thread-local pointer, and model loading is
+  // the scenarios are independent: run them on `jobs` threads (each loop's
+  // hand is registered for its own mjData, and model loading is
   // serialised), each keeping its time series only as long as it needs it
   ExtremesResult result;
   result.scenarios.assign(table.size(), ExtremeResult{});

@@ -325,8 +325,8 @@ std::vector<Setting> ladder(const PrecisionOptions& o, const PrecisionResult& r)
   return settings;
 }
 
-// The two references, side by side (each loop has its own thread and finds
-// its hand through a thread-local pointer); the check bounds the
+// The two references, side by side (each loop has its own thread, and its
+// hand is registered for its own mjData); the check bounds the
 // reference's own error, which sets the fit's floor.
 Trajectory run_references(const PrecisionOptions& o, PrecisionResult* r) {
   Trajectory ref, ref_check;
