@@ -14,4 +14,10 @@ const char* device_error_name(DeviceError e) {
   return "unknown";
 }
 
+DeviceError HapticDevice::read_state(DeviceState* state) noexcept {
+  const DeviceError e = read_joints(&state->q_device_rad);
+  state->present = e == DeviceError::kOk ? kStateJoints : 0u;
+  return e;
+}
+
 }  // namespace vmh

@@ -15,6 +15,7 @@
 #define VMHAPTICS_DEVICE_HAPTIC_DEVICE_H_
 
 #include "controller/types.h"
+#include "device/device_state.h"
 
 namespace vmh {
 
@@ -38,6 +39,13 @@ class HapticDevice {
   // The six joint angles, device convention (t1..t6, rad). On an error
   // *q_device_rad is left unspecified.
   virtual DeviceError read_joints(Joints* q_device_rad) noexcept = 0;
+
+  // Everything the device reports this tick (device/device_state.h), read
+  // once. The default is read_joints() alone (present = kStateJoints);
+  // backends with switches, a clock or their own kinematics override it,
+  // and decorators forward it. On an error *state is left unspecified
+  // apart from `present`, which is then 0.
+  virtual DeviceError read_state(DeviceState* state) noexcept;
 
   // Torques for motors t1..t3 (N m), held until the next call (zero-order
   // hold). A non-finite entry must make the device send zero torque.

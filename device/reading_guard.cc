@@ -35,24 +35,30 @@ void ReadingGuard::reset() noexcept {
 }
 
 DeviceError ReadingGuard::read_joints(Joints* q_device_rad) noexcept {
-  Joints q;
-  const DeviceError err = inner_->read_joints(&q);
+  DeviceState state;
+  const DeviceError err = read_state(&state);
+  if (err == DeviceError::kOk) *q_device_rad = state.q_device_rad;
+  return err;
+}
+
+DeviceError ReadingGuard::read_state(DeviceState* state) noexcept {
+  const DeviceError err = inner_->read_state(state);
+  const Joints q = state->q_device_rad;
   fault_ = GuardFault::kNone;
   if (err != DeviceError::kOk) {
     // nothing to compare the next reading with
     have_previous_ = false;
     return err;
   }
-  if (!params_.enabled) {
-    *q_device_rad = q;
-    return DeviceError::kOk;
-  }
+  if (!params_.enabled) return DeviceError::kOk;
   if (latched_) {
     fault_ = GuardFault::kJump;
+    state->present = 0;
     return DeviceError::kSensorFault;
   }
   if (!q.allFinite()) {
     fault_ = GuardFault::kNonFinite;
+    state->present = 0;
     // after a gap the joints may have moved any distance: the first good
     // reading is not compared (a jump that coincides with it goes unseen)
     have_previous_ = false;
@@ -65,13 +71,13 @@ DeviceError ReadingGuard::read_joints(Joints* q_device_rad) noexcept {
       if (std::abs(q[j] - previous_[j]) > max_step_rad_) {
         latched_ = true;
         fault_ = GuardFault::kJump;
+        state->present = 0;
         return DeviceError::kSensorFault;
       }
     }
   }
   previous_ = q;
   have_previous_ = true;
-  *q_device_rad = q;
   return DeviceError::kOk;
 }
 

@@ -48,6 +48,9 @@ class ReadingGuard final : public HapticDevice {
   ReadingGuard(HapticDevice* inner, const GuardParams& params);
 
   DeviceError read_joints(Joints* q_device_rad) noexcept override;
+  // the inner device's state, refused (present = 0, kSensorFault) when its
+  // joint angles fail the checks; the other fields pass through
+  DeviceError read_state(DeviceState* state) noexcept override;
   DeviceError write_motor_torques(const Vec3& tau_motor_Nm) noexcept override;
 
   // clears the latch and the previous reading (re-homing)

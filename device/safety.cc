@@ -180,9 +180,18 @@ bool SafetyLayer::service_watchdog(double now_s) noexcept {
 }
 
 DeviceError SafetyLayer::read_joints(Joints* q_device_rad) noexcept {
+  DeviceState state;
+  const DeviceError err = read_state(&state);
+  if (err == DeviceError::kOk) *q_device_rad = state.q_device_rad;
+  return err;
+}
+
+DeviceError SafetyLayer::read_state(DeviceState* state) noexcept {
   status_ = kSafetyOk;
-  // the time step since the last read: stamped, or one servo period
+  // the time step since the last read: stamped by the caller, else by the
+  // device's own clock (below), else one servo period
   dt_s_ = params_.servo_period_s;
+  const bool caller_stamped = stamped_;
   if (stamped_) {
     if (have_stamp_ && std::isfinite(stamp_s_ - last_stamp_s_) &&
         stamp_s_ > last_stamp_s_) {
@@ -194,13 +203,13 @@ DeviceError SafetyLayer::read_joints(Joints* q_device_rad) noexcept {
     }
   }
 
-  // the motors held the last torque over the interval that just ended
-  update_heat(tau_prev_);
-
-  Joints q;
-  DeviceError err = inner_->read_joints(&q);
+  DeviceError err = inner_->read_state(state);
+  const Joints q = state->q_device_rad;
   if (err == DeviceError::kOk && !q.allFinite()) err = DeviceError::kSensorFault;
   if (err != DeviceError::kOk) {
+    state->present = 0;
+    // the motors held the last torque over the interval that just ended
+    update_heat(tau_prev_);
     have_reading_ = false;
     have_previous_ = false;  // nothing to take a velocity from
     good_reads_ = 0;
@@ -210,6 +219,21 @@ DeviceError SafetyLayer::read_joints(Joints* q_device_rad) noexcept {
     return err;
   }
   failed_reads_ = 0;
+  // the device's own clock, when the caller gave none
+  if (!caller_stamped && state->has(kStateTimestamp) &&
+      std::isfinite(state->timestamp_s)) {
+    if (have_stamp_ && state->timestamp_s > last_stamp_s_) {
+      dt_s_ = state->timestamp_s - last_stamp_s_;
+    }
+    last_stamp_s_ = state->timestamp_s;
+    have_stamp_ = true;
+  }
+  update_heat(tau_prev_);
+  // the switches, where the device reports them (set_inputs() otherwise)
+  if (state->has(kStateInkwell)) docked_ = state->docked;
+  if (state->has(kStateButtons) && params_.deadman_buttons != 0) {
+    deadman_ = (state->buttons & params_.deadman_buttons) != 0;
+  }
   // the ramp's clock: the time from the write that started it to this read
   if (ramp_running_) {
     ramp_elapsed_s_ = std::min(ramp_elapsed_s_ + dt_s_, params_.ramp_s);
@@ -257,7 +281,6 @@ DeviceError SafetyLayer::read_joints(Joints* q_device_rad) noexcept {
   p_prev_m_ = p_m;
   have_previous_ = true;
   have_reading_ = true;
-  *q_device_rad = q;
   return DeviceError::kOk;
 }
 

@@ -133,8 +133,10 @@ struct SafetyParams {
   // -- watchdog: servo periods without a kick before it expires. Estimate.
   int watchdog_periods = 10;
 
-  // -- dead-man: cut force unless set_inputs() says the button is held
+  // -- dead-man: cut force unless the button is held (from the device's
+  // buttons, the bits of deadman_buttons, any of them; or set_inputs())
   bool require_deadman = false;
+  std::uint32_t deadman_buttons = kButton1;
 
   // Throws std::invalid_argument naming the first bad field.
   void validate() const;
@@ -166,6 +168,10 @@ class SafetyLayer final : public HapticDevice {
               const OmniParams& omni = OmniParams());
 
   DeviceError read_joints(Joints* q_device_rad) noexcept override;
+  // The inner device's state. Its inkwell switch and buttons (where
+  // present) feed the docked and dead-man cuts, and its timestamp the time
+  // step, unless set_read_time() stamped this read.
+  DeviceError read_state(DeviceState* state) noexcept override;
   // Sends the limited torque. Returns the inner device's error, or
   // kInvalidCommand for a non-finite command (zero is then sent).
   DeviceError write_motor_torques(const Vec3& tau_motor_Nm) noexcept override;
@@ -174,8 +180,8 @@ class SafetyLayer final : public HapticDevice {
   // one servo period after the last. Also the watchdog's kick time.
   void set_read_time(double now_s) noexcept;
 
-  // Inkwell switch and dead-man button. The HapticDevice interface does not
-  // report them yet; the device-state work will feed them here each tick.
+  // Inkwell switch and dead-man button, for a device that does not report
+  // them in its DeviceState (a report, when present, overrides these).
   void set_inputs(bool docked, bool deadman_pressed) noexcept;
 
   // Force output on/off (OpenHaptics HD_FORCE_OUTPUT). On at construction;

@@ -6,10 +6,16 @@ namespace vmh {
 
 ServoTickResult servo_tick(HapticDevice* device, Controller* controller,
                            ControlOutput* out) noexcept {
+  DeviceState state;
+  return servo_tick(device, controller, out, &state);
+}
+
+ServoTickResult servo_tick(HapticDevice* device, Controller* controller,
+                           ControlOutput* out, DeviceState* state) noexcept {
   ServoTickResult r;
-  Joints q_device;
-  r.read = device->read_joints(&q_device);
+  r.read = device->read_state(state);
   if (r.read != DeviceError::kOk) {
+    state->present = 0;
     // nothing trustworthy to act on: zero torque, and forget the error rate
     // so that the next good reading does not produce a derivative kick
     controller->reset();
@@ -17,7 +23,7 @@ ServoTickResult servo_tick(HapticDevice* device, Controller* controller,
     r.write = device->write_motor_torques(Vec3::Zero());
     return r;
   }
-  r.control = controller->tick(device_to_dh_joints(q_device), out);
+  r.control = controller->tick(device_to_dh_joints(state->q_device_rad), out);
   // the controller already zeroes its output on a fault; say so explicitly
   const Vec3 tau = is_fault(r.control) ? Vec3::Zero() : out->tau_motor_Nm;
   r.zeroed = is_fault(r.control);

@@ -28,6 +28,12 @@ struct ServoTickResult {
 ServoTickResult servo_tick(HapticDevice* device, Controller* controller,
                            ControlOutput* out) noexcept;
 
+// The same, reading the device's whole state (HapticDevice::read_state)
+// into *state for the caller to record (buttons, inkwell, timestamp, the
+// device's own kinematics). *state has present = 0 after a failed read.
+ServoTickResult servo_tick(HapticDevice* device, Controller* controller,
+                           ControlOutput* out, DeviceState* state) noexcept;
+
 }  // namespace vmh
 
 #endif  // VMHAPTICS_DEVICE_SERVO_TICK_H_
