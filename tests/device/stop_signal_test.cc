@@ -1,0 +1,102 @@
+// StopSignals: a raised SIGINT or SIGTERM is recorded, not fatal, and the
+// handler that was there before comes back afterwards.
+#include "device/stop_signal.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <atomic>
+#include <stdexcept>
+
+namespace vmh {
+namespace {
+
+std::atomic<int> g_previous_calls{0};
+extern "C" void previous_handler(int) { g_previous_calls.fetch_add(1); }
+
+// installs previous_handler for signo, and puts back what was there
+class PreviousHandler {
+ public:
+  explicit PreviousHandler(int signo) : signo_(signo) {
+    struct sigaction sa {};
+    sa.sa_handler = previous_handler;
+    sigemptyset(&sa.sa_mask);
+    sigaction(signo_, &sa, &saved_);
+  }
+  ~PreviousHandler() { sigaction(signo_, &saved_, nullptr); }
+
+ private:
+  int signo_;
+  struct sigaction saved_ {};
+};
+
+void (*current_handler(int signo))(int) {
+  struct sigaction now {};
+  sigaction(signo, nullptr, &now);
+  return now.sa_handler;
+}
+
+TEST(StopSignals, NothingRequestedAtFirst) {
+  StopSignals s;
+  EXPECT_FALSE(s.requested());
+  EXPECT_EQ(s.signal_number(), 0);
+}
+
+TEST(StopSignals, SigintIsRecorded) {
+  StopSignals s;
+  ASSERT_EQ(raise(SIGINT), 0);  // the process would end without the handler
+  EXPECT_TRUE(s.requested());
+  EXPECT_EQ(s.signal_number(), SIGINT);
+}
+
+TEST(StopSignals, SigtermIsRecorded) {
+  StopSignals s;
+  ASSERT_EQ(raise(SIGTERM), 0);
+  EXPECT_TRUE(s.requested());
+  EXPECT_EQ(s.signal_number(), SIGTERM);
+}
+
+TEST(StopSignals, ANewInstanceStartsClear) {
+  {
+    StopSignals s;
+    raise(SIGINT);
+    ASSERT_TRUE(s.requested());
+  }
+  StopSignals again;
+  EXPECT_FALSE(again.requested());
+}
+
+TEST(StopSignals, OnlyOneAtATime) {
+  StopSignals s;
+  EXPECT_THROW(StopSignals second, std::logic_error);
+  raise(SIGTERM);
+  EXPECT_EQ(s.signal_number(), SIGTERM);  // the first still works
+}
+
+TEST(StopSignals, ThePreviousHandlersAreRestored) {
+  for (int signo : {SIGINT, SIGTERM}) {
+    PreviousHandler prev(signo);
+    g_previous_calls.store(0);
+    {
+      StopSignals s;
+      EXPECT_NE(current_handler(signo), &previous_handler);
+      raise(signo);
+      EXPECT_EQ(s.signal_number(), signo);
+      EXPECT_EQ(g_previous_calls.load(), 0);  // not the old handler
+    }
+    EXPECT_EQ(current_handler(signo), &previous_handler);
+    raise(signo);
+    EXPECT_EQ(g_previous_calls.load(), 1);  // the old handler again
+  }
+}
+
+TEST(StopSignals, DefaultDispositionIsRestored) {
+  // gtest leaves SIGINT and SIGTERM at SIG_DFL
+  ASSERT_EQ(current_handler(SIGINT), SIG_DFL);
+  { StopSignals s; }
+  EXPECT_EQ(current_handler(SIGINT), SIG_DFL);
+  EXPECT_EQ(current_handler(SIGTERM), SIG_DFL);
+}
+
+}  // namespace
+}  // namespace vmh
