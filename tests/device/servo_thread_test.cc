@@ -322,7 +322,7 @@ TEST(ServoThread, StallHandlerFiresOncePerStall) {
   BlockingLoop loop;
   std::atomic<int> stalls{0};
   ServoThread t(&loop, normal(1e-3));
-  t.set_stall_handler(count_stall, &stalls, 20);
+  t.set_stall_handler(count_stall, &stalls, 50);
   t.start();
   loop.block_at(30);
   ASSERT_TRUE(wait_for([&] { return stalls.load() >= 1; }));
