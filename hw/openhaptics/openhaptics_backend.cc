@@ -384,16 +384,18 @@ ServoReport OpenHapticsBackend::start(ServoLoop* loop,
   api_->hdStartScheduler();
   code = setup_error();
   if (code != kSuccess) {
-    stop();
+    stop();  // no scheduler: stop() does not ask it for a zero frame
     throw DeviceOpenError("openhaptics: hdStartScheduler failed: " +
                           describe(code));
   }
+  scheduler_ok_ = true;
   const bool ran = wait_for(
       [&] {
         return frames_.load(std::memory_order_acquire) > 0 || !running();
       },
       2.0);
   if (!ran) {
+    scheduler_ok_ = false;  // a synchronous call could wait for ever
     stop();
     throw DeviceOpenError(
         "openhaptics: the HD scheduler ran no servo frame within 2 s");
@@ -413,9 +415,12 @@ void OpenHapticsBackend::stop() noexcept {
   if (stopped_.exchange(true)) return;
   if (started_.load()) {
     stop_requested_.store(true, std::memory_order_release);
-    // a scheduler that stopped calling (a dead device) must not hang stop()
-    wait_for([&] { return !running(); }, 1.0);
-    api_->hdScheduleSynchronous(&zero_callback, this, kMaxSchedulerPriority);
+    // a scheduler that stopped calling (a dead device) must not hang stop(),
+    // nor be asked for a synchronous frame it would never run
+    const bool ended = wait_for([&] { return !running(); }, 1.0);
+    if (scheduler_ok_ && ended) {
+      api_->hdScheduleSynchronous(&zero_callback, this, kMaxSchedulerPriority);
+    }
     api_->hdStopScheduler();
     api_->hdUnschedule(servo_handle_);
   }

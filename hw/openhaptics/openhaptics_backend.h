@@ -96,7 +96,9 @@ class OpenHapticsBackend final : public DeviceBackend {
   // options.period_s is refused. Throws DeviceOpenError on an HD error.
   ServoReport start(ServoLoop* loop, const ServoOptions& options) override;
   // Ends the callback, sends zero torque in one more (synchronous) frame,
-  // stops the scheduler and disables the device. Once stopped, the backend
+  // stops the scheduler and disables the device. The zero frame is skipped
+  // when the scheduler never ran or the callback did not end within 1 s (a
+  // synchronous call would then wait for ever). Once stopped, the backend
   // cannot be started again.
   void stop() noexcept override;
   bool running() const noexcept override {
@@ -161,6 +163,8 @@ class OpenHapticsBackend final : public DeviceBackend {
   std::atomic<long> frames_{0};
   std::atomic<int> sched_policy_{-1};  // the scheduler thread's, first frame
   hd::HDSchedulerHandle servo_handle_ = 0;
+  // hdStartScheduler succeeded and the scheduler ran a frame
+  bool scheduler_ok_ = false;
   // the first fatal error (DeviceError as int; 0 = none)
   std::atomic<int> fault_{0};
   std::atomic<hd::HDerror> last_code_{hd::kSuccess};

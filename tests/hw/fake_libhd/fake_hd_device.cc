@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "device/tick_timer.h"
@@ -88,12 +89,15 @@ class RigidOmni final : public HapticDevice {
 
 }  // namespace
 
-std::unique_ptr<HapticDevice> fake_hd_make_device(
-    const std::vector<std::string>& model_tokens) {
+std::unique_ptr<HapticDevice> fake_hd_make_device(const std::string& config) {
   bool docked = false;
   std::uint32_t buttons = 0;
-  for (const std::string& t : model_tokens) {
-    if (t == "docked") {
+  std::stringstream in(config);
+  std::string t;
+  while (std::getline(in, t, ',')) {
+    if (t.empty()) {
+      continue;
+    } else if (t == "docked") {
       docked = true;
     } else if (t == "button1") {
       buttons |= kButton1;

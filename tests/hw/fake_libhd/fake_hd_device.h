@@ -5,19 +5,17 @@
 
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "device/haptic_device.h"
 
 namespace vmh::fake_hd {
 
 // A running device in the device convention (t1..t6 rad, t3 absolute; motor
-// torques N m). `model_tokens` are the configuration's tokens the library
-// itself does not handle ("docked", "button1", "button2"); an unknown one
-// throws std::invalid_argument naming it. The device's clock runs from its
-// creation: each read advances it to the monotonic time of the call.
-std::unique_ptr<HapticDevice> fake_hd_make_device(
-    const std::vector<std::string>& model_tokens);
+// torques N m). `config` holds the configuration's comma-separated tokens
+// the library itself does not handle ("docked", "button1", "button2"); an
+// unknown one throws std::invalid_argument naming it. The device runs in
+// real time from its creation.
+std::unique_ptr<HapticDevice> fake_hd_make_device(const std::string& config);
 
 }  // namespace vmh::fake_hd
 

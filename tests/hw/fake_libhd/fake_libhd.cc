@@ -234,7 +234,7 @@ std::vector<std::string> split(const std::string& s) {
 FAKE_HD_EXPORT HHD hdInitDevice(HDstring config) {
   const std::string name = config != nullptr ? config : "";
   std::vector<Fault> faults;
-  std::vector<std::string> model_tokens;
+  std::string model_tokens;  // comma-separated, for the device model
   bool no_encoders = false;
   bool uncalibrated = false;
   bool bad = false;
@@ -259,7 +259,7 @@ FAKE_HD_EXPORT HHD hdInitDevice(HDstring config) {
     } else if (t == "missing") {
       bad = true;
     } else {
-      model_tokens.push_back(t);
+      model_tokens += t + ",";
     }
   }
   std::unique_ptr<vmh::HapticDevice> dev;
