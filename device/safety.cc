@@ -7,6 +7,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "device/motor_force_map.h"
 
 namespace vmh {
 
@@ -249,13 +250,8 @@ DeviceError SafetyLayer::read_state(DeviceState* state) noexcept {
 
   const Joints q_dh = device_to_dh_joints(q);
   const Vec3 p_m = omni_fk(omni_, q_dh).p_base_m;
-  const Mat3 J = linear_jacobian(omni_, q_dh);
-  // F_base solves J^T F = tau_dh; damped least squares keeps it finite at a
-  // singularity: F = (J J^T + l^2 I)^-1 J tau_dh
-  const double l2 = params_.singular_damping_m * params_.singular_damping_m;
-  const Mat3 JJt = J * J.transpose() + l2 * Mat3::Identity();
-  const Mat3 M = matrix_of([](const Vec3& v) { return motor_to_dh_torques(v); });
-  torque_to_force_ = R_device_base() * JJt.inverse() * J * M;
+  torque_to_force_ =
+      motor_torque_to_force_map(omni_, q, params_.singular_damping_m);
   if (!torque_to_force_.allFinite()) {
     // cannot happen for finite angles and l > 0; a cut is the safe answer
     have_reading_ = false;
