@@ -120,7 +120,10 @@ TEST(Emulator, TourMovesAllSixJoints) {
     }
     sleep_s(2e-3);
   }
+  const EmulatorTruth t = emu.truth();
   emu.stop();
+  std::printf("tour: %ld periods stepped, %ld dropped to stay in real time\n",
+              t.periods, t.lag_periods);
   for (int i = 0; i < 6; ++i) {
     EXPECT_GT(hi[i] - lo[i], 0.05) << "t" << i + 1 << " barely moved";
   }
@@ -145,6 +148,10 @@ TEST(Emulator, PositiveMotorOneTorqueTurnsT1Positively) {
   EXPECT_GT(q1[0] - q0[0], 0.02);
   EXPECT_LT(t.q_true_dh[0] - q1_true0, -0.02);
   EXPECT_NEAR(t.motor_torque_Nm[0], 0.05, 1e-12);
+  // the hand let go: its spring and damper are zeroed at each step's start;
+  // what is left is RK4's inner stages (the grip moved by part of a step)
+  EXPECT_LT(t.hand_force_N.norm(), 0.05);
+  std::printf("hand force while let go: %.2e N\n", t.hand_force_N.norm());
 }
 
 TEST(Emulator, NonFiniteWriteHoldsZeroTorque) {
@@ -289,6 +296,49 @@ TEST(Emulator, DockProgramReachesTheInkwell) {
   EXPECT_NEAR(ink_mm.y(), -65.51, 1.0);
   EXPECT_NEAR(ink_mm.z(), -88.11, 1.0);
   emu.stop();
+}
+
+TEST(Emulator, CaseProgramPlaysTheScenesScript) {
+  EmulatorOptions o = options(HandProgram::kCase);
+  o.realtime_factor = 4.0;  // 4 s of the script in 1 s
+  Emulator emu(o);
+  emu.start();
+  ASSERT_TRUE(wait_for([&] { return emu.truth().t_sim_s > 4.0; }, 3.0));
+  const EmulatorTruth t = emu.truth();
+  emu.stop();
+  // the target of the period that ended at t_sim_s was set at its start
+  const double t0 = t.t_sim_s - emu.servo_period_s();
+  const ScriptPose want = emu.loop().script().at(t0);
+  EXPECT_LT((t.hand_target.p_mm - want.p_mm).norm(), 1e-9);
+  EXPECT_EQ(t.segment, emu.loop().script().segment_at(t0));
+  EXPECT_GE(t.segment, 1);
+  EXPECT_TRUE(t.state_finite);
+}
+
+TEST(Emulator, GimbalSweepReachesBothEndsOfEachGimbalJoint) {
+  EmulatorOptions o = options(HandProgram::kGimbalSweep);
+  o.realtime_factor = 3.0;  // the 9 s sweep in 3 s
+  Emulator emu(o);
+  emu.start();
+  Joints lo = Joints::Constant(1e9), hi = Joints::Constant(-1e9);
+  const double end = monotonic_now_s() + 4.0;
+  while (monotonic_now_s() < end && emu.truth().t_sim_s < 9.5) {
+    DeviceState s;
+    if (emu.read_state(&s) == DeviceError::kOk) {
+      lo = lo.cwiseMin(s.q_device_rad);
+      hi = hi.cwiseMax(s.q_device_rad);
+    }
+    sleep_s(5e-4);
+  }
+  emu.stop();
+  // each gimbal joint within 0.15 rad of both ends of its range (the
+  // device convention's range is the DH one, symmetric, docs/sources.md §5)
+  const OmniParams omni = emu.loop().controller_params().omni;
+  for (int i = 3; i < 6; ++i) {
+    const double top = omni.joint_upper_rad[static_cast<std::size_t>(i)];
+    EXPECT_GT(hi[i], top - 0.15) << "t" << i + 1;
+    EXPECT_LT(lo[i], -top + 0.15) << "t" << i + 1;
+  }
 }
 
 TEST(Emulator, RawReadingsDecodeToTheReportedAngles) {
