@@ -13,10 +13,10 @@
 // lag_periods). Emulator time (t_sim_s) is the simulated time: it stops
 // while the physics is stalled or dropping periods, as a device's would.
 //
-// read_state / read_joints / write_motor_torques are for one servo thread:
-// noexcept, no allocation, no lock (Seqlock and atomics). Everything else
-// (press_buttons, set_hand_program, inject, set_calibration, truth) may be
-// called from any thread.
+// read_state / read_joints / write_motor_torques are for one servo thread
+// (or calls serialised with it): noexcept, no allocation, no lock (Seqlock
+// and atomics). press_buttons, set_hand_program, inject and truth may be
+// called from any thread; set_calibration from one thread at a time.
 //
 // Readings. Joints in the device convention through the sensor model, as
 // SimDevice's (encoders whole counts of 15000 per revolution; gimbal pots
@@ -67,10 +67,13 @@ enum class HandProgram {
   // cone of 0.5 rad about its start direction and rolls +-0.6 rad about
   // itself, so all six joints move
   kTour,
-  // the hand lets go: after each step's control callback its wrench is
-  // cleared, so the device moves only under its motors (and gravity, off
-  // in the thesis scenes). The hand's mass stays on the grip (SimHand adds
-  // it to the model; removing it would need a second model)
+  // the hand lets go: before each physics step its target is put on the
+  // grip's present pose and velocity, so its spring and damper exert
+  // nothing at the step's start (exactly zero with Euler; RK4's inner
+  // stages see the grip moved by part of a step: about 0.02 N at the
+  // speeds of the tests). The device moves under its motors (and gravity,
+  // off in the thesis scenes). The hand's mass stays on the grip (SimHand
+  // adds it to the model; removing it would need a second model)
   kNone,
   // the stylus into the inkwell (kInkwellDevice_rad) and held there; the
   // target is corrected by the remaining error, as an eye would guide it

@@ -419,8 +419,14 @@ TEST(Emulator, ServoCallsAllocateNothingAlongsidePhysics) {
   {
     vmh::testing::AllocationScope scope;  // counts every thread's new
     go.store(true);
+    // every hand program runs in the physics thread meanwhile
+    for (HandProgram p : {HandProgram::kCase, HandProgram::kNone,
+                          HandProgram::kDock, HandProgram::kGimbalSweep,
+                          HandProgram::kTour}) {
+      emu.set_hand_program(p);
+      sleep_s(0.15);
+    }
     while (ok.load() + timeouts.load() + bad.load() < 1000) sleep_s(0.01);
-    sleep_s(0.5);
     allocations = scope.count();
   }
   servo.join();
