@@ -1,0 +1,438 @@
+#include "sim/emulator.h"
+
+#include <mujoco/mujoco.h>
+#include <time.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <stdexcept>
+
+#include "controller/device_frame.h"
+#include "controller/omni_kinematics.h"
+#include "device/tick_timer.h"
+#include "sim/closed_loop.h"
+#include "sim/emulator_hand.h"
+#include "sim/sensor_model.h"
+
+#ifndef VMH_DEFAULT_MODELS_DIR
+#define VMH_DEFAULT_MODELS_DIR "models"
+#endif
+
+namespace vmh::sim {
+namespace {
+
+// how far the physics may fall behind before it drops periods, periods
+constexpr long kMaxCatchUpPeriods = 3;
+// a stalled physics shows as timeouts once its snapshot is this many
+// periods old
+constexpr double kStaleReadPeriods = 2.0;
+
+bool all_finite(const mjtNum* v, int n) {
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(v[i])) return false;
+  }
+  return true;
+}
+
+// FNV-1a: a fixed per-serial number for the factory calibration
+std::uint64_t serial_hash(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
+
+timespec to_timespec(std::int64_t ns) {
+  timespec ts;
+  ts.tv_sec = static_cast<time_t>(ns / 1000000000);
+  ts.tv_nsec = static_cast<long>(ns % 1000000000);
+  return ts;
+}
+
+void sleep_until_ns(std::int64_t ns) noexcept {
+  const timespec ts = to_timespec(ns);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+// The hidden factory calibration of a device: encoder offsets near the
+// drivers' inkwell offsets (-0.23 rad for t1, +0.37 rad for t2,
+// docs/sources.md §9.2), whole counts, moved per serial; pots reading the
+// sensor model's 2^bits levels (its span: the joint's range) with a
+// per-serial count of codes below the range's lower end. Computed exactly
+// as SensorModel computes its levels, so that decoding gives its values.
+hw::OmniCalibration factory_for(const std::string& serial,
+                                const OmniParams& omni) {
+  const std::uint64_t h = serial_hash(serial);
+  const double step = hw::encoder_step_rad();
+  const double base_counts[3] = {std::round(-0.23 / step),
+                                 std::round(0.37 / step), 0.0};
+  hw::OmniCalibration cal;
+  Joints lo_dh, hi_dh;
+  for (int i = 0; i < 6; ++i) {
+    lo_dh[i] = omni.joint_lower_rad[static_cast<std::size_t>(i)];
+    hi_dh[i] = omni.joint_upper_rad[static_cast<std::size_t>(i)];
+  }
+  const Joints a = dh_to_device_joints(lo_dh);
+  const Joints b = dh_to_device_joints(hi_dh);
+  const double levels = std::ldexp(1.0, omni.gimbal_pot_bits);
+  for (int i = 0; i < 3; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double moved = static_cast<double>((h >> (8 * i)) % 201) - 100.0;
+    cal.encoder_offset_rad[k] = (base_counts[i] + moved) * step;
+    const int j = i + 3;
+    const double pot_step = std::abs(b[j] - a[j]) / (levels - 1.0);
+    const double below = static_cast<double>(8 + (h >> (8 * i + 32)) % 33);
+    cal.pot_gain_rad[k] = pot_step;
+    cal.pot_offset_rad[k] = std::min(a[j], b[j]) - below * pot_step;
+  }
+  return cal;
+}
+
+}  // namespace
+
+struct Emulator::PhysicsState {
+  explicit PhysicsState(ClosedLoop* loop)
+      : hand(loop), sensor(loop->controller_params().omni, true) {
+    const mjModel* m = loop->model();
+    qpos_before.assign(static_cast<std::size_t>(m->nq), 0.0);
+    dq.assign(static_cast<std::size_t>(m->nv), 0.0);
+    mv.assign(static_cast<std::size_t>(m->nv), 0.0);
+  }
+  EmulatorHand hand;
+  SensorModel sensor;  // always quantising (see the header)
+  std::vector<mjtNum> qpos_before, dq, mv;
+  // past readings, for a late fault
+  std::array<Published, kMaxLatePeriods + 1> ring{};
+  long periods = 0;
+  long lag = 0;
+  double t_sim_s = 0.0;
+  double energy_motor_J = 0.0;
+  double energy_hand_J = 0.0;
+  std::array<bool, kMaxFaults> taken{};
+  double late_until_s = -1.0;
+  int late_count = 0;
+  double unplug_until_s = -1.0;
+  std::uint64_t replug_writes = 0;  // writes before the last replug
+  bool watchdog_fired = false;
+  bool invalid_command = false;
+  bool stalled = false;
+  ScriptPose target;
+  int segment = 0;
+  HandProgram program = HandProgram::kTour;
+};
+
+Emulator::Emulator(const EmulatorOptions& options) : options_(options) {
+  if (!(options_.realtime_factor > 0.0) || !std::isfinite(options_.realtime_factor)) {
+    throw std::invalid_argument("EmulatorOptions: realtime_factor must be finite and > 0");
+  }
+  if (!std::isfinite(options_.device_watchdog_s)) {
+    throw std::invalid_argument("EmulatorOptions: device_watchdog_s must be finite");
+  }
+  if (options_.serial.empty()) {
+    throw std::invalid_argument("EmulatorOptions: serial must not be empty");
+  }
+  for (const EmulatorFault& f : options_.faults) validate_emulator_fault(f);
+  if (options_.faults.size() > static_cast<std::size_t>(kMaxFaults)) {
+    throw std::invalid_argument("EmulatorOptions: more than " +
+                                std::to_string(kMaxFaults) + " faults");
+  }
+  if (options_.scene.empty()) {
+    options_.scene = std::string(VMH_DEFAULT_MODELS_DIR) + "/cases/case1.xml";
+  }
+  loop_ = std::make_unique<ClosedLoop>(options_.scene, options_.overrides);
+  period_s_ = loop_->controller_params().servo_period_s;
+  substeps_ = loop_->substeps();
+  factory_ = factory_for(options_.serial, loop_->controller_params().omni);
+  cal_.write(factory_);
+  program_.store(static_cast<int>(options_.hand));
+  ps_ = std::make_unique<PhysicsState>(loop_.get());
+  for (const EmulatorFault& f : options_.faults) inject(f);
+}
+
+Emulator::~Emulator() { stop(); }
+
+Vec3 Emulator::inkwell_mm() const noexcept { return ps_->hand.inkwell_mm(); }
+Vec3 Emulator::inkwell_axis() const noexcept { return ps_->hand.inkwell_axis(); }
+
+DeviceIdentity Emulator::identity() const {
+  DeviceIdentity id;
+  id.backend = "emulator";
+  id.config = options_.scene;
+  id.model = "PHANTOM Omni (MuJoCo emulator)";
+  id.vendor = "vmhaptics";
+  id.serial = options_.serial;
+  const int v = mj_version();
+  id.api_version = "MuJoCo " + std::to_string(v / 100) + "." +
+                   std::to_string((v / 10) % 10) + "." + std::to_string(v % 10);
+  id.input_dof = 6;
+  id.output_dof = 3;
+  return id;
+}
+
+void Emulator::set_calibration(const hw::OmniCalibration& cal) {
+  cal.validate();
+  cal_.write(cal);
+}
+
+void Emulator::inject(const EmulatorFault& fault) {
+  validate_emulator_fault(fault);
+  const int i = fault_count_.fetch_add(1);
+  if (i >= kMaxFaults) {
+    fault_count_.fetch_sub(1);
+    throw std::length_error("Emulator::inject: more than " +
+                            std::to_string(kMaxFaults) + " faults");
+  }
+  FaultSlot& slot = faults_[i];
+  slot.fault = fault;
+  slot.fault.at_s = std::max(fault.at_s, t_sim_now_s_.load());
+  slot.ready.store(true, std::memory_order_release);
+}
+
+void Emulator::start() {
+  if (running_.load()) throw DeviceOpenError("emulator: already running");
+  if (thread_.joinable()) thread_.join();
+  // a fresh run: the start pose, at rest, emulator time 0; faults given
+  // before now keep their times from this start
+  loop_->reset();
+  ps_ = std::make_unique<PhysicsState>(loop_.get());
+  drops_.store(0);
+  unplugged_.store(false);
+  t_sim_now_s_.store(0.0);
+  stop_.store(false);
+  publish(monotonic_now_s());
+  running_.store(true);
+  try {
+    thread_ = std::thread([this] { run(); });
+  } catch (const std::system_error& e) {
+    running_.store(false);
+    throw DeviceOpenError(std::string("emulator: cannot start the physics thread: ") +
+                          e.what());
+  }
+}
+
+void Emulator::stop() noexcept {
+  stop_.store(true);
+  if (thread_.joinable()) thread_.join();
+  running_.store(false);
+  if (loop_) loop_->device().reset();  // zero torque at the motors
+}
+
+void Emulator::run() noexcept {
+  const std::int64_t period_ns = to_ns(period_s_ / options_.realtime_factor);
+  std::int64_t deadline_ns = to_ns(monotonic_now_s());
+  while (!stop_.load(std::memory_order_relaxed)) {
+    const double freeze_s = step_period();
+    if (freeze_s > 0.0) {
+      // a stall: the thread does nothing, in short sleeps so stop() is
+      // not held up
+      const std::int64_t until = to_ns(monotonic_now_s()) + to_ns(freeze_s);
+      while (!stop_.load(std::memory_order_relaxed) &&
+             to_ns(monotonic_now_s()) < until) {
+        sleep_until_ns(std::min(until, to_ns(monotonic_now_s()) + 1000000));
+      }
+      deadline_ns = to_ns(monotonic_now_s());
+      continue;
+    }
+    deadline_ns += period_ns;
+    const std::int64_t now_ns = to_ns(monotonic_now_s());
+    const std::int64_t behind = now_ns - deadline_ns;
+    if (behind > kMaxCatchUpPeriods * period_ns) {
+      ps_->lag += behind / period_ns;
+      deadline_ns = now_ns;
+    }
+    sleep_until_ns(deadline_ns);
+  }
+}
+
+double Emulator::apply_faults(double t_s) noexcept {
+  PhysicsState& ps = *ps_;
+  double freeze_s = 0.0;
+  const int n = std::min(fault_count_.load(std::memory_order_acquire), kMaxFaults);
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (ps.taken[k] || !faults_[i].ready.load(std::memory_order_acquire)) continue;
+    const EmulatorFault& f = faults_[i].fault;
+    if (t_s + 1e-12 < f.at_s) continue;
+    ps.taken[k] = true;
+    switch (f.kind) {
+      case EmulatorFaultKind::kDrop: drops_.fetch_add(f.count); break;
+      case EmulatorFaultKind::kLate:
+        ps.late_until_s = t_s + f.duration_s;
+        ps.late_count = f.count;
+        break;
+      case EmulatorFaultKind::kStall: freeze_s = std::max(freeze_s, f.duration_s); break;
+      case EmulatorFaultKind::kUnplug:
+        ps.unplug_until_s = std::max(ps.unplug_until_s, t_s + f.duration_s);
+        unplugged_.store(true);
+        break;
+    }
+  }
+  if (unplugged_.load(std::memory_order_relaxed) && t_s >= ps.unplug_until_s) {
+    // replugged: the motors wait for a fresh command
+    ps.replug_writes = command_.read().count;
+    unplugged_.store(false);
+  }
+  if (ps.late_count > 0 && t_s >= ps.late_until_s) ps.late_count = 0;
+  return freeze_s;
+}
+
+Vec3 Emulator::motor_command(double now_s) noexcept {
+  PhysicsState& ps = *ps_;
+  const Command c = command_.read();
+  ps.invalid_command = c.invalid;
+  ps.watchdog_fired = false;
+  if (unplugged_.load(std::memory_order_relaxed) || c.count <= ps.replug_writes) {
+    return Vec3::Zero();
+  }
+  if (options_.device_watchdog_s > 0.0 &&
+      now_s - c.wall_s > options_.device_watchdog_s) {
+    ps.watchdog_fired = true;
+    return Vec3::Zero();
+  }
+  return c.tau_Nm;
+}
+
+double Emulator::step_period() noexcept {
+  PhysicsState& ps = *ps_;
+  const double freeze_s = apply_faults(ps.t_sim_s);
+  if (freeze_s > 0.0) {
+    ps.stalled = true;
+    return freeze_s;
+  }
+  const HandProgram program = static_cast<HandProgram>(program_.load());
+  ps.program = program;
+  ps.hand.set_target(program, ps.t_sim_s, &ps.target, &ps.segment);
+  // the command reaches the motors through SimDevice: its clamps and its
+  // delay line (one write per period)
+  loop_->device().write_motor_torques(motor_command(monotonic_now_s()));
+
+  const mjModel* m = loop_->model();
+  mjData* d = loop_->data();
+  for (int i = 0; i < substeps_; ++i) {
+    if (program == HandProgram::kNone) ps.hand.let_go();
+    mju_copy(ps.qpos_before.data(), d->qpos, m->nq);
+    mj_step(m, d);
+    // the passivity observer, as ClosedLoop::tick keeps it
+    mj_differentiatePos(m, ps.dq.data(), 1.0, ps.qpos_before.data(), d->qpos);
+    ps.energy_motor_J += mju_dot(d->qfrc_actuator, ps.dq.data(), m->nv);
+    ps.energy_hand_J += mju_dot(d->qfrc_applied, ps.dq.data(), m->nv);
+  }
+  ++ps.periods;
+  ps.t_sim_s = static_cast<double>(ps.periods) * period_s_;
+  t_sim_now_s_.store(ps.t_sim_s, std::memory_order_relaxed);
+  publish(monotonic_now_s());
+  ps.stalled = false;
+  return 0.0;
+}
+
+void Emulator::publish(double now_s) noexcept {
+  PhysicsState& ps = *ps_;
+  const mjModel* m = loop_->model();
+  mjData* d = loop_->data();
+  SimDevice& dev = loop_->device();
+  const Joints q_dh = dev.true_q_dh();
+
+  Published p;
+  p.publish_wall_s = now_s;
+  p.finite = q_dh.allFinite();
+  DeviceState& s = p.state;
+  EmulatorTruth t;
+  if (p.finite) {
+    const Joints q_meas = ps.sensor.measure(dh_to_device_joints(q_dh));
+    s.encoder_counts = hw::encoder_counts_from_angles(q_meas.head<3>(), factory_);
+    s.gimbal_pots = hw::pot_codes_from_angles(q_meas.tail<3>(), factory_);
+    s.q_device_rad = hw::angles_from_raw(s.encoder_counts, s.gimbal_pots, cal_.read());
+    s.docked = ps.hand.docked(q_dh, &t.p_true_mm, &t.stylus_axis);
+  }
+  s.timestamp_s = now_s;
+  s.present = kStateJoints | kStateButtons | kStateInkwell | kStateTimestamp |
+              kStateEncoders | kStatePots;
+  ps.ring[static_cast<std::size_t>(ps.periods % (kMaxLatePeriods + 1))] = p;
+  if (ps.late_count > 0 && ps.periods >= ps.late_count) {
+    // a late reading: an old snapshot, with its old timestamp, delivered now
+    Published old = ps.ring[static_cast<std::size_t>(
+        (ps.periods - ps.late_count) % (kMaxLatePeriods + 1))];
+    old.publish_wall_s = now_s;
+    state_.write(old);
+  } else {
+    state_.write(p);
+  }
+
+  t.t_sim_s = ps.t_sim_s;
+  t.wall_s = now_s;
+  t.periods = ps.periods;
+  t.lag_periods = ps.lag;
+  t.q_true_dh = q_dh;
+  if (p.finite) {
+    t.nearest_true_mm = loop_->nearest_on_path_mm(t.p_true_mm);
+    t.d_path_mm = loop_->distance_to_path_mm(t.p_true_mm);
+  }
+  t.hand_force_N = base_to_device_vector(loop_->hand().force_N());
+  t.hand_target = ps.target;
+  t.segment = ps.segment;
+  t.program = ps.program;
+  t.motor_torque_Nm = dev.motor_torque_Nm();
+  t.energy_motor_J = ps.energy_motor_J;
+  t.energy_hand_J = ps.energy_hand_J;
+  mj_mulM(m, d, ps.mv.data(), d->qvel);
+  t.kinetic_J = 0.5 * mju_dot(d->qvel, ps.mv.data(), m->nv);
+  t.state_finite = all_finite(d->qpos, m->nq) && all_finite(d->qvel, m->nv) &&
+                   all_finite(d->qacc, m->nv) && all_finite(d->ctrl, m->nu);
+  t.docked = s.docked;
+  t.device_watchdog_fired = ps.watchdog_fired;
+  t.invalid_command = ps.invalid_command;
+  t.unplugged = unplugged_.load(std::memory_order_relaxed);
+  t.stalled = ps.stalled;
+  t.late = ps.late_count > 0;
+  t.drops_pending = drops_.load(std::memory_order_relaxed);
+  truth_.write(t);
+}
+
+DeviceError Emulator::read_state(DeviceState* state) noexcept {
+  state->present = 0;
+  if (!running_.load(std::memory_order_acquire) ||
+      unplugged_.load(std::memory_order_acquire)) {
+    return DeviceError::kNotConnected;
+  }
+  int drops = drops_.load(std::memory_order_relaxed);
+  while (drops > 0) {
+    if (drops_.compare_exchange_weak(drops, drops - 1)) return DeviceError::kTimeout;
+  }
+  const Published p = state_.read();
+  const double stale_s = kStaleReadPeriods * period_s_ / options_.realtime_factor;
+  if (monotonic_now_s() - p.publish_wall_s > stale_s) return DeviceError::kTimeout;
+  if (!p.finite) return DeviceError::kSensorFault;
+  *state = p.state;
+  state->buttons = buttons_.load(std::memory_order_relaxed);
+  return DeviceError::kOk;
+}
+
+DeviceError Emulator::read_joints(Joints* q_device_rad) noexcept {
+  DeviceState s;
+  const DeviceError e = read_state(&s);
+  if (e == DeviceError::kOk) *q_device_rad = s.q_device_rad;
+  return e;
+}
+
+DeviceError Emulator::write_motor_torques(const Vec3& tau_motor_Nm) noexcept {
+  if (!running_.load(std::memory_order_acquire) ||
+      unplugged_.load(std::memory_order_acquire)) {
+    return DeviceError::kNotConnected;
+  }
+  Command c;
+  c.invalid = !tau_motor_Nm.allFinite();
+  c.tau_Nm = c.invalid ? Vec3::Zero() : tau_motor_Nm;
+  c.wall_s = monotonic_now_s();
+  c.count = writes_.fetch_add(1, std::memory_order_relaxed) + 1;
+  command_.write(c);
+  return c.invalid ? DeviceError::kInvalidCommand : DeviceError::kOk;
+}
+
+}  // namespace vmh::sim

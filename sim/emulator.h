@@ -1,0 +1,282 @@
+// The emulator: the MuJoCo Omni (a scene ClosedLoop loads, models/omni with
+// the hand) stepped in real time in its own thread behind HapticDevice, so
+// that every `hw` command runs without hardware.
+//
+// Threads. The physics thread (start()/stop()) runs one servo period
+// (the case's servo_period_s) at a time: it sets the hand's target from the
+// hand program at emulator time, applies the latest motor command through
+// SimDevice (its clamps and delay line), runs the period's mj_step calls
+// (h = the scene's timestep), publishes a snapshot, and sleeps to an
+// absolute deadline (clock_nanosleep, TIMER_ABSTIME, CLOCK_MONOTONIC). When
+// it falls more than kMaxCatchUpPeriods behind it drops the missed periods
+// instead of racing to catch up, and counts them (EmulatorTruth::
+// lag_periods). Emulator time (t_sim_s) is the simulated time: it stops
+// while the physics is stalled or dropping periods, as a device's would.
+//
+// read_state / read_joints / write_motor_torques are for one servo thread
+// (or calls serialised with it): noexcept, no allocation, no lock (Seqlock
+// and atomics). press_buttons, set_hand_program, inject and truth may be
+// called from any thread; set_calibration from one thread at a time.
+//
+// Readings. Joints in the device convention through the sensor model, as
+// SimDevice's (encoders whole counts of 15000 per revolution; gimbal pots
+// 2^11 levels over each joint's range, docs/sources.md §6), then turned
+// into raw values with the emulator's hidden "factory" calibration and
+// back to angles with the current calibration (hw/omni_calibration.h).
+// The factory encoder offsets are whole counts and the factory pots are
+// the sensor model's levels, so with the factory calibration the reported
+// angles equal SimDevice's to rounding (1e-15 rad). The pots therefore
+// read 11-bit codes, not §9.2's example 10-bit ones: a 10-bit pot on top of
+// the sensor model would quantise twice. The emulator always quantises,
+// whatever the case's `quantize`.
+//
+// The device-side watchdog: if no write arrived for device_watchdog_s of
+// wall time (after the first write), the physics thread holds zero torque,
+// as a device's firmware does, until the next write.
+//
+// Torque sign: positive motor torque on t1 turns t1 positively (device
+// convention), through SimDevice and the model's actuators.
+#ifndef VMHAPTICS_SIM_EMULATOR_H_
+#define VMHAPTICS_SIM_EMULATOR_H_
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "device/device_backend.h"
+#include "device/haptic_device.h"
+#include "device/seqlock.h"
+#include "hw/omni_calibration.h"
+#include "sim/hand_script.h"
+
+namespace vmh::sim {
+
+class ClosedLoop;
+
+// What the hand does while nobody holds the device. Device frame, mm.
+enum class HandProgram {
+  // the scene's own script (HandScript) from t = 0 at start(), then its
+  // last target held still
+  kCase,
+  // a closed tour of the workspace, period kTourPeriod_s: the wrist centre
+  // on a 3-D Lissajous curve of +-kTourAmplitude_mm (frequencies 1, 2, 3
+  // per period) about the case's start point; the stylus axis circles a
+  // cone of 0.5 rad about its start direction and rolls +-0.6 rad about
+  // itself, so all six joints move
+  kTour,
+  // the hand lets go: before each physics step its target is put on the
+  // grip's present pose and velocity, so its spring and damper exert
+  // nothing at the step's start (exactly zero with Euler; RK4's inner
+  // stages see the grip moved by part of a step: about 0.02 N at the
+  // speeds of the tests). The device moves under its motors (and gravity,
+  // off in the thesis scenes). The hand's mass stays on the grip (SimHand
+  // adds it to the model; removing it would need a second model)
+  kNone,
+  // the stylus into the inkwell (kInkwellDevice_rad) and held there; the
+  // target is corrected by the remaining error, as an eye would guide it
+  kDock,
+  // for calibration: the arm held at the start pose while each gimbal joint
+  // t4, t5, t6 in turn is turned to one end of its range, to the other and
+  // back (kSweepLeg_s per leg), the target 0.15 rad past the end so that
+  // the hand's rotational spring presses it against the joint limit
+  kGimbalSweep,
+};
+const char* hand_program_name(HandProgram p);  // "case", "tour", ...
+// throws std::invalid_argument naming the unknown program
+HandProgram parse_hand_program(const std::string& name);
+
+inline constexpr double kTourPeriod_s = 8.0;
+inline constexpr double kTourAmplitude_mm = 50.0;
+inline constexpr double kSweepLeg_s = 1.0;
+
+// The inkwell (dock) pose, device convention, rad: an ESTIMATE. t1..t3 put
+// the wrist centre at OpenHaptics's inkwell position (0, -65.5, -88.1) mm
+// (docs/omni.md), t5 tilts the stylus 36 deg below horizontal, tip forward;
+// nobody has measured it on a device. Within the ranges of docs/sources.md
+// §5 (OmniParams).
+inline constexpr double kInkwellDevice_rad[6] = {0.0,  -0.647, -0.477,
+                                                 0.0,  1.0,    0.0};
+// the inkwell switch closes when the true wrist centre is within this of
+// the inkwell's and the stylus axis within this angle of the inkwell's
+inline constexpr double kDockRadius_mm = 5.0;
+inline constexpr double kDockAngle_deg = 15.0;
+
+enum class EmulatorFaultKind {
+  kDrop,    // the next `count` reads return kTimeout
+  kLate,    // for duration_s, reads return a snapshot `count` periods old
+  kStall,   // the physics freezes for duration_s (reads time out)
+  kUnplug,  // for duration_s reads and writes return kNotConnected, zero
+            // torque held; then replugged
+};
+const char* emulator_fault_name(EmulatorFaultKind k);  // "drop", ...
+
+struct EmulatorFault {
+  EmulatorFaultKind kind = EmulatorFaultKind::kDrop;
+  double at_s = 0.0;        // emulator time from start()
+  double duration_s = 0.0;  // late, stall, unplug
+  int count = 0;            // drop: reads; late: periods (1..kMaxLatePeriods)
+};
+inline constexpr int kMaxLatePeriods = 63;
+
+// "drop@1.0:5,late@2.0:0.5:3,stall@3:0.2,unplug@4:1": kind@at_s then
+// drop:count, late:duration_s:count, stall:duration_s, unplug:duration_s.
+// Empty text: no faults. Throws std::invalid_argument naming the bad item.
+std::vector<EmulatorFault> parse_emulator_faults(const std::string& text);
+// Throws std::invalid_argument naming the fault's bad field.
+void validate_emulator_fault(const EmulatorFault& fault);
+
+struct EmulatorOptions {
+  // a scene ClosedLoop can load; empty: models/cases/case1.xml of the
+  // models directory the build was configured with
+  std::string scene;
+  std::vector<std::string> overrides;
+  HandProgram hand = HandProgram::kTour;
+  double realtime_factor = 1.0;  // simulated s per wall s (> 0)
+  std::string serial = "EMU-0001";
+  std::vector<EmulatorFault> faults;
+  double device_watchdog_s = 0.05;  // <= 0: no device watchdog
+};
+
+// Ground truth of the last period, for tests and for the trace of a
+// real-time run (sim::TraceRow's truth fields). Device frame, mm, unless
+// named.
+struct EmulatorTruth {
+  double t_sim_s = 0.0;       // emulator time at the end of the period
+  double wall_s = 0.0;        // CLOCK_MONOTONIC when published
+  long periods = 0;           // periods stepped since start()
+  long lag_periods = 0;       // periods dropped to stay in real time
+  Joints q_true_dh = Joints::Zero();  // MuJoCo's joint angles, DH, rad
+  Vec3 p_true_mm = Vec3::Zero();      // omni_fk of q_true_dh
+  Vec3 nearest_true_mm = Vec3::Zero();  // nearest point of the VM's path
+  double d_path_mm = 0.0;             // distance of p_true_mm to the path
+  Vec3 stylus_axis = Vec3::UnitZ();   // true stylus axis, unit
+  Vec3 hand_force_N = Vec3::Zero();   // the hand's force on the grip
+  ScriptPose hand_target;             // the hand program's target
+  int segment = 0;                    // kCase: index into the script's segments
+  HandProgram program = HandProgram::kTour;
+  Vec3 motor_torque_Nm = Vec3::Zero();  // held by the motors (after delay)
+  double energy_motor_J = 0.0;  // passivity observer, as ClosedLoop's
+  double energy_hand_J = 0.0;
+  double kinetic_J = 0.0;
+  bool state_finite = true;
+  bool docked = false;
+  bool device_watchdog_fired = false;  // zero held: no write in time
+  bool invalid_command = false;        // the last write was not finite
+  bool unplugged = false;
+  bool stalled = false;  // (seen only after a stall: the thread was frozen)
+  bool late = false;
+  int drops_pending = 0;
+};
+
+class Emulator final : public HapticDevice {
+ public:
+  // Loads the scene (throws SimError naming the file and field) and checks
+  // the options (std::invalid_argument naming the field). Does not start.
+  explicit Emulator(const EmulatorOptions& options);
+  ~Emulator() override;
+  Emulator(const Emulator&) = delete;
+  Emulator& operator=(const Emulator&) = delete;
+
+  // Launches the physics thread (emulator time 0). Throws DeviceOpenError
+  // if it is already running or cannot be started.
+  void start();
+  // Joins the physics thread; idempotent.
+  void stop() noexcept;
+  bool running() const noexcept { return running_.load(); }
+
+  DeviceError read_joints(Joints* q_device_rad) noexcept override;
+  DeviceError read_state(DeviceState* state) noexcept override;
+  DeviceError write_motor_torques(const Vec3& tau_motor_Nm) noexcept override;
+
+  EmulatorTruth truth() const noexcept { return truth_.read(); }
+  DeviceIdentity identity() const;
+
+  void press_buttons(std::uint32_t mask) noexcept { buttons_.store(mask); }
+  void set_hand_program(HandProgram p) noexcept {
+    program_.store(static_cast<int>(p));
+  }
+  // Schedules a fault (at max(at_s, now)); any thread. Throws
+  // std::invalid_argument for a bad fault, std::length_error past
+  // kMaxFaults faults in all.
+  void inject(const EmulatorFault& fault);
+  static constexpr int kMaxFaults = 64;
+
+  // The calibration readings are decoded with (validated; throws
+  // std::invalid_argument naming the field).
+  void set_calibration(const hw::OmniCalibration& cal);
+  hw::OmniCalibration calibration() const noexcept { return cal_.read(); }
+  // the hidden truth: what an ideal calibration would find
+  const hw::OmniCalibration& factory_calibration() const noexcept {
+    return factory_;
+  }
+
+  // the scene's loop (model, script, path): read-only use while running
+  const ClosedLoop& loop() const { return *loop_; }
+  double servo_period_s() const noexcept { return period_s_; }
+  // the inkwell's wrist centre (mm) and stylus axis, device frame
+  Vec3 inkwell_mm() const noexcept;
+  Vec3 inkwell_axis() const noexcept;
+
+ private:
+  // a reading and when it was published (wall clock: a stalled physics
+  // thread is told from a late reading, whose own timestamp is old)
+  struct Published {
+    DeviceState state;
+    double publish_wall_s = 0.0;
+    bool finite = true;
+  };
+  struct Command {
+    Vec3 tau_Nm = Vec3::Zero();
+    double wall_s = 0.0;
+    std::uint64_t count = 0;  // writes so far
+    bool invalid = false;
+  };
+  struct FaultSlot {
+    std::atomic<bool> ready{false};
+    std::atomic<bool> taken{false};  // the physics thread has acted on it
+    EmulatorFault fault;
+  };
+
+  void run() noexcept;
+  // one servo period; returns the seconds to freeze for (a stall), else 0
+  double step_period() noexcept;
+  double apply_faults(double t_s) noexcept;
+  Vec3 motor_command(double now_s) noexcept;
+  void publish(double now_s) noexcept;
+
+  EmulatorOptions options_;
+  std::unique_ptr<ClosedLoop> loop_;
+  double period_s_ = 1e-3;
+  int substeps_ = 1;
+  hw::OmniCalibration factory_;
+
+  std::thread thread_;
+  std::atomic<bool> running_{false};
+  std::atomic<bool> stop_{false};
+
+  // shared with the servo thread and others
+  Seqlock<hw::OmniCalibration> cal_;
+  Seqlock<Command> command_;
+  Seqlock<EmulatorTruth> truth_;
+  Seqlock<Published> state_;
+  std::atomic<std::uint32_t> buttons_{0};
+  std::atomic<int> program_{0};
+  std::atomic<int> drops_{0};
+  std::atomic<bool> unplugged_{false};
+  std::atomic<std::uint64_t> writes_{0};  // the servo thread's count
+  std::atomic<double> start_wall_s_{0.0};
+  std::atomic<double> t_sim_now_s_{0.0};
+  FaultSlot faults_[kMaxFaults];
+  std::atomic<int> fault_count_{0};
+
+  // the physics thread's own
+  struct PhysicsState;
+  std::unique_ptr<PhysicsState> ps_;
+};
+
+}  // namespace vmh::sim
+
+#endif  // VMHAPTICS_SIM_EMULATOR_H_
