@@ -3,15 +3,20 @@
 //
 // Verbs: kin (kinematics of the Omni), ctl (one controller tick), run
 // (closed-loop simulation of the thesis cases), study (numerical studies),
-// params (the table of case parameters, docs/parameters.md).
+// params (the table of case parameters, docs/parameters.md), hw (a device,
+// real or emulated: docs/hardware.md).
 //
-// Exit codes: 0 success, 2 bad usage or bad input, 1 any other failure.
+// Exit codes: 0 success, 2 bad usage or bad input (a device that cannot be
+// opened included), 1 any other failure, 128 + n when signal n (SIGINT,
+// SIGTERM) stopped an hw session (its trace is kept, zero torque sent).
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
 
 #include "cli/args.h"
 #include "cli/ctl.h"
+#include "cli/hw.h"
+#include "cli/hw_common.h"
 #include "cli/kin.h"
 #include "cli/params.h"
 #include "cli/run.h"
@@ -60,6 +65,7 @@ int main(int argc, char** argv) {
   vmh::cli::register_run(&app);
   vmh::cli::register_study(&app);
   vmh::cli::register_params(&app);
+  vmh::cli::register_hw(&app);
 
   try {
     check_verbs(&app, argc, argv);
@@ -76,6 +82,12 @@ int main(int argc, char** argv) {
   } catch (const vmh::cli::UsageError& e) {
     std::cerr << "vmhaptics: error: " << first_line(e.what()) << '\n';
     return 2;
+  } catch (const vmh::DeviceOpenError& e) {
+    std::cerr << "vmhaptics: error: " << first_line(e.what()) << '\n';
+    return 2;
+  } catch (const vmh::cli::SignalStop& e) {
+    std::cerr << "vmhaptics: " << first_line(e.what()) << '\n';
+    return 128 + e.signal;
   } catch (const std::exception& e) {
     std::cerr << "vmhaptics: error: " << first_line(e.what()) << '\n';
     return 1;

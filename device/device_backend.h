@@ -79,7 +79,7 @@ class DeviceBackend {
   // true while the loop runs (false once it returned false or stop() ran)
   virtual bool running() const noexcept = 0;
   // Timing of the ticks so far (safe to call while running).
-  virtual TickStats timing() const noexcept = 0;
+  virtual TickStats timing() const = 0;
 };
 
 }  // namespace vmh

@@ -1,6 +1,8 @@
 #include "sim/emulator.h"
 
 #include <mujoco/mujoco.h>
+#include <pthread.h>
+#include <sched.h>
 #include <time.h>
 
 #include <algorithm>
@@ -26,8 +28,10 @@ namespace {
 // how far the physics may fall behind before it drops periods, periods
 constexpr long kMaxCatchUpPeriods = 3;
 // a stalled physics shows as timeouts once its snapshot is this many
-// periods old
-constexpr double kStaleReadPeriods = 2.0;
+// periods old: one period of normal age, and one more late period
+// forgiven (the physics thread, like the servo thread, is sometimes a few
+// hundred microseconds late on a loaded host)
+constexpr double kStaleReadPeriods = 3.0;
 
 bool all_finite(const mjtNum* v, int n) {
   for (int i = 0; i < n; ++i) {
@@ -225,6 +229,12 @@ void Emulator::stop() noexcept {
 }
 
 void Emulator::run() noexcept {
+  if (options_.realtime_priority > 0) {
+    // best effort: refused without CAP_SYS_NICE, and then it runs as before
+    sched_param sp{};
+    sp.sched_priority = options_.realtime_priority;
+    (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+  }
   const std::int64_t period_ns = to_ns(period_s_ / options_.realtime_factor);
   std::int64_t deadline_ns = to_ns(monotonic_now_s());
   while (!stop_.load(std::memory_order_relaxed)) {

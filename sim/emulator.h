@@ -135,6 +135,10 @@ struct EmulatorOptions {
   std::vector<std::string> overrides;
   HandProgram hand = HandProgram::kTour;
   double realtime_factor = 1.0;  // simulated s per wall s (> 0)
+  // run the physics thread under SCHED_FIFO at this priority when the
+  // system allows it (a device's firmware does not wait for the host's
+  // scheduler either); 0: normal scheduling
+  int realtime_priority = 70;
   std::string serial = "EMU-0001";
   std::vector<EmulatorFault> faults;
   double device_watchdog_s = 0.05;  // <= 0: no device watchdog

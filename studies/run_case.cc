@@ -58,6 +58,8 @@ std::string trace_csv(const std::vector<TraceRow>& rows, const ClosedLoop& loop)
   return s;
 }
 
+}  // namespace
+
 nlohmann::json claim_json(const Claim& c) {
   return {{"name", c.name},         {"statement", c.statement},
           {"window", c.window},     {"value", c.value},
@@ -67,7 +69,22 @@ nlohmann::json claim_json(const Claim& c) {
           {"pass", c.pass}};
 }
 
-}  // namespace
+nlohmann::json metrics_json(const RunMetrics& m) {
+  return {{"ticks", m.ticks},
+          {"rms_path_error_mm", m.rms_path_error_mm},
+          {"max_path_error_mm", m.max_path_error_mm},
+          {"rms_xv_error_mm", m.rms_xv_error_mm},
+          {"mean_force_N", m.mean_force_N},
+          {"rms_force_N", m.rms_force_N},
+          {"max_force_N", m.max_force_N},
+          {"time_on_path_s", m.time_on_path_s},
+          {"on_path_within_mm", kOnPathMm},
+          {"force_saturated_ticks", m.force_saturated_ticks},
+          {"torque_saturated_ticks", m.torque_saturated_ticks},
+          {"fault_ticks", m.fault_ticks},
+          {"placement_not_converged_ticks", m.placement_not_converged_ticks},
+          {"max_placement_iterations", m.max_placement_iterations}};
+}
 
 const std::vector<CaseEntry>& thesis_cases() {
   static const std::vector<CaseEntry> cases = {
@@ -206,21 +223,7 @@ CaseResult run_case(const std::string& name, const std::string& scene,
         {"servo_period_s", loop.controller_params().servo_period_s},
         {"gravity_m_s2", {model->opt.gravity[0], model->opt.gravity[1], model->opt.gravity[2]}}}},
       {"parameters", params},
-      {"metrics",
-       {{"ticks", m.ticks},
-        {"rms_path_error_mm", m.rms_path_error_mm},
-        {"max_path_error_mm", m.max_path_error_mm},
-        {"rms_xv_error_mm", m.rms_xv_error_mm},
-        {"mean_force_N", m.mean_force_N},
-        {"rms_force_N", m.rms_force_N},
-        {"max_force_N", m.max_force_N},
-        {"time_on_path_s", m.time_on_path_s},
-        {"on_path_within_mm", kOnPathMm},
-        {"force_saturated_ticks", m.force_saturated_ticks},
-        {"torque_saturated_ticks", m.torque_saturated_ticks},
-        {"fault_ticks", m.fault_ticks},
-        {"placement_not_converged_ticks", m.placement_not_converged_ticks},
-        {"max_placement_iterations", m.max_placement_iterations}}},
+      {"metrics", metrics_json(m)},
       {"mujoco_warnings", warning_total},
       {"mujoco_warning_kinds", warnings},
       {"claims", claims},

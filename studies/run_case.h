@@ -64,6 +64,10 @@ void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
                const std::string& out_dir, int threads);
 
+// summary.json's pieces, for other writers of the same format (hw run)
+nlohmann::json claim_json(const Claim& c);
+nlohmann::json metrics_json(const RunMetrics& m);
+
 // The trace's column names, in order.
 std::vector<std::string> trace_columns(int vm_dof);
 

@@ -49,7 +49,7 @@ bool wait_for(const std::function<bool()>& done, double limit_s) {
 }
 
 // a reading, retried for up to a second: a loaded machine can delay the
-// physics thread by the two periods after which a read times out
+// physics thread by the three periods after which a read times out
 DeviceError read_ok(Emulator* emu, DeviceState* s) {
   DeviceError e = emu->read_state(s);
   const double end = monotonic_now_s() + 1.0;
@@ -206,7 +206,7 @@ ReadCounts read_for(Emulator* emu, double s) {
 
 TEST(Emulator, DropFaultTimesOutExactlyCountReads) {
   // a slow physics (10 ms periods): a loaded machine does not delay it the
-  // two periods that would make a read time out by itself
+  // three periods that would make a read time out by itself
   EmulatorOptions o = options(HandProgram::kTour);
   o.realtime_factor = 0.1;
   Emulator emu(o);
@@ -384,7 +384,7 @@ TEST(Emulator, ServoCallsAllocateNothingAlongsidePhysics) {
   // a servo thread for 1 s (created before counting starts: creating a
   // thread allocates), reading and writing every 0.25 ms while the physics
   // thread steps; a timeout is allowed (a loaded machine can delay the
-  // physics by two periods), any other error or a step back in time is not
+  // physics by three periods), any other error or a step back in time is not
   std::atomic<bool> go{false};
   std::atomic<long> ok{0}, timeouts{0}, bad{0}, backwards{0};
   std::thread servo([&] {

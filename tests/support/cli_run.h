@@ -22,15 +22,16 @@ struct CliRun {
   std::string err;
 };
 
-// runs `vmhaptics <args>` through the shell, capturing stdout and stderr
-inline CliRun run(const std::string& args) {
+// runs `vmhaptics <args>` through the shell, capturing stdout and stderr;
+// `env` (e.g. "VAR=value ") is put before the command
+inline CliRun run(const std::string& args, const std::string& env = "") {
   // a file of its own: ctest runs the test cases in parallel processes
   std::string err_path = ::testing::TempDir() + "vmh_cli_stderr_XXXXXX";
   const int fd = mkstemp(err_path.data());
   if (fd < 0) return CliRun{};
   close(fd);
   const std::string cmd =
-      std::string(VMH_CLI_PATH) + " " + args + " 2>" + err_path;
+      env + std::string(VMH_CLI_PATH) + " " + args + " 2>" + err_path;
   CliRun r;
   FILE* pipe = popen(cmd.c_str(), "r");
   if (pipe == nullptr) return r;

@@ -1,0 +1,203 @@
+#include "cli/hw_backends.h"
+
+#include <dirent.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "cli/args.h"
+#include "cli/hw_calibration_store.h"
+#include "device/servo_thread.h"
+#include "hw/openhaptics/hd_library.h"
+#include "hw/openhaptics/openhaptics_backend.h"
+#include "sim/emulator.h"
+#include "studies/run_case.h"
+
+namespace vmh::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The emulator behind DeviceBackend: its physics thread, and the project's
+// own servo thread driving the loop, as a native driver will.
+class EmulatorBackend final : public DeviceBackend {
+ public:
+  explicit EmulatorBackend(const sim::EmulatorOptions& o) : emu_(o) {}
+  ~EmulatorBackend() override { stop(); }
+
+  DeviceIdentity identity() const override { return emu_.identity(); }
+  CalibrationState calibration_state() override { return CalibrationState::kOk; }
+  HapticDevice* device() noexcept override { return &emu_; }
+
+  ServoReport start(ServoLoop* loop, const ServoOptions& options) override {
+    emu_.start();
+    thread_ = std::make_unique<ServoThread>(loop, options);
+    return thread_->start();
+  }
+  void stop() noexcept override {
+    if (thread_) thread_->stop();
+    (void)emu_.write_motor_torques(Vec3::Zero());
+    emu_.stop();
+  }
+  bool running() const noexcept override {
+    return thread_ != nullptr && thread_->running();
+  }
+  TickStats timing() const override {
+    return thread_ ? thread_->timing() : TickStats{};
+  }
+
+  sim::Emulator* emulator() { return &emu_; }
+
+ private:
+  sim::Emulator emu_;
+  std::unique_ptr<ServoThread> thread_;
+};
+
+sim::HandProgram hand_program(const std::string& name) {
+  if (name == "case") return sim::HandProgram::kCase;
+  if (name == "tour") return sim::HandProgram::kTour;
+  if (name == "none") return sim::HandProgram::kNone;
+  if (name == "dock") return sim::HandProgram::kDock;
+  if (name == "gimbal_sweep") return sim::HandProgram::kGimbalSweep;
+  throw UsageError("--hand: unknown '" + name +
+                   "' (expected case, tour, none, dock or gimbal_sweep)");
+}
+
+OpenedDevice open_emulator(const DeviceSpec& spec, const OpenOptions& oo) {
+  sim::EmulatorOptions eo;
+  std::string name;
+  try {
+    eo.scene = studies::resolve_scene(spec.argument.empty() ? "case1" : spec.argument,
+                                      &name);
+    eo.faults = sim::parse_emulator_faults(oo.faults);
+  } catch (const std::exception& e) {
+    throw UsageError(std::string("--device emulator: ") + e.what());
+  }
+  eo.overrides = oo.overrides;
+  eo.hand = hand_program(oo.hand);
+  auto backend = std::make_unique<EmulatorBackend>(eo);
+  OpenedDevice dev;
+  dev.emulator = backend->emulator();
+  dev.calibration_source = "factory (the emulator's own)";
+  if (oo.load_calibration) {
+    std::optional<StoredCalibration> stored;
+    try {
+      stored = load_calibration(backend->identity().serial);
+    } catch (const std::runtime_error& e) {
+      throw UsageError(std::string("stored calibration: ") + e.what());
+    }
+    if (stored) {
+      dev.emulator->set_calibration(stored->calibration);
+      dev.calibration_source = calibration_path(backend->identity().serial);
+    }
+  }
+  dev.backend = std::move(backend);
+  return dev;
+}
+
+OpenedDevice open_openhaptics(const DeviceSpec& spec, const OpenOptions& oo) {
+  hw::OpenHapticsOptions ho;
+  ho.config = spec.argument;
+  try {
+    ho.command = hw::parse_hd_command(oo.hd_command);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--hd-command: ") + e.what());
+  }
+  OpenedDevice dev;
+  dev.backend = std::make_unique<hw::OpenHapticsBackend>(ho);
+  dev.calibration_source = "the OpenHaptics driver (hdCheckCalibration)";
+  return dev;
+}
+
+// device nodes whose names start with `prefix` in /dev
+Json dev_nodes(const std::string& prefix) {
+  Json out = Json::array();
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator("/dev", ec)) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind(prefix, 0) == 0) out.push_back(e.path().string());
+  }
+  return out;
+}
+
+std::string read_line(const fs::path& p) {
+  std::ifstream in(p);
+  std::string s;
+  std::getline(in, s);
+  return s;
+}
+
+// USB devices with a Touch's IDs (docs/sources.md §9.3), from sysfs
+Json usb_touch_devices() {
+  Json out = Json::array();
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator("/sys/bus/usb/devices", ec)) {
+    const std::string v = read_line(e.path() / "idVendor");
+    const std::string p = read_line(e.path() / "idProduct");
+    const bool touch = (v == "0301" && p == "2988") ||
+                       (v == "2988" && (p == "0302" || p == "0304"));
+    if (touch) out.push_back(e.path().filename().string() + " " + v + ":" + p);
+  }
+  return out;
+}
+
+}  // namespace
+
+DeviceSpec parse_device_spec(const std::string& text) {
+  DeviceSpec s;
+  const auto colon = text.find(':');
+  s.backend = text.substr(0, colon);
+  if (colon != std::string::npos) s.argument = text.substr(colon + 1);
+  if (s.backend != "emulator" && s.backend != "openhaptics") {
+    throw UsageError("--device: unknown backend '" + s.backend +
+                     "' (expected emulator[:case|scene.xml] or "
+                     "openhaptics[:CONFIG_NAME]; `vmhaptics hw list` shows "
+                     "what is available)");
+  }
+  return s;
+}
+
+OpenedDevice open_device(const DeviceSpec& spec, const OpenOptions& options) {
+  if (spec.backend == "emulator") return open_emulator(spec, options);
+  return open_openhaptics(spec, options);
+}
+
+Json list_backends() {
+  Json list = Json::array();
+  list.push_back(Json{{"name", "emulator"},
+                      {"device", "emulator[:case|scene.xml]"},
+                      {"available", true},
+                      {"found", "the MuJoCo Omni, scenes in " + studies::models_dir()},
+                      {"verified_on_hardware", false}});
+  Json oh{{"name", "openhaptics"},
+          {"device", "openhaptics[:CONFIG_NAME]"},
+          {"looked_for", hw::hd::HdLibrary::describe_search()},
+          {"verified_on_hardware", false}};
+  try {
+    hw::hd::HdLibrary lib;
+    oh["available"] = true;
+    oh["found"] = lib.file();
+  } catch (const DeviceOpenError& e) {
+    oh["available"] = false;
+    oh["why_not"] = e.what();
+  }
+  list.push_back(oh);
+  list.push_back(Json{{"name", "firewire"},
+                      {"device", "(native driver, not in this version)"},
+                      {"available", false},
+                      {"found", dev_nodes("fw")},
+                      {"why_not", "the native FireWire Omni driver is not built "
+                                  "yet; use openhaptics for a FireWire Omni"},
+                      {"verified_on_hardware", false}});
+  list.push_back(Json{{"name", "usb_touch"},
+                      {"device", "(native driver, not in this version)"},
+                      {"available", false},
+                      {"found", usb_touch_devices()},
+                      {"why_not", "the native USB Touch driver is not built "
+                                  "yet; use openhaptics for a Touch"},
+                      {"verified_on_hardware", false}});
+  return Json{{"backends", list}};
+}
+
+}  // namespace vmh::cli

@@ -1,0 +1,146 @@
+#include "cli/hw_common.h"
+
+#include <csignal>
+#include <ctime>
+
+#include "cli/args.h"
+#include "report/output_file.h"
+
+namespace vmh::cli {
+
+void add_hw_common(CLI::App* cmd, HwCommon* c) {
+  cmd->add_option("--device", c->device,
+                  "emulator[:case|scene.xml] (default) or "
+                  "openhaptics[:CONFIG_NAME]");
+  cmd->add_option("--hand", c->hand,
+                  "emulator: what holds the stylus: case, tour, none, dock, "
+                  "gimbal_sweep (default depends on the verb)");
+  cmd->add_option("--fault", c->faults,
+                  "emulator: transport faults, e.g. "
+                  "drop@1.0:5,late@2:0.5:3,stall@3:0.2,unplug@4:1");
+  cmd->add_option("--hd-command", c->hd_command,
+                  "openhaptics: joint_torque (HD_CURRENT_JOINT_TORQUE, "
+                  "mN m; default) or force (HD_CURRENT_FORCE, N)");
+  cmd->add_flag("--no-realtime", c->no_realtime,
+                "do not ask for SCHED_FIFO and mlockall");
+  cmd->add_flag("--require-deadman", c->require_deadman,
+                "no force unless button 1 is held");
+  cmd->add_flag("--no-calibration", c->no_calibration,
+                "ignore the stored calibration for this serial number");
+  cmd->add_flag("--quiet", c->quiet, "no progress lines on stderr");
+}
+
+OpenedDevice open_hw_device(const HwCommon& c, const std::string& default_hand,
+                            const std::vector<std::string>& overrides) {
+  OpenOptions oo;
+  oo.overrides = overrides;
+  oo.hand = c.hand.empty() ? default_hand : c.hand;
+  oo.faults = c.faults;
+  oo.hd_command = c.hd_command;
+  oo.load_calibration = !c.no_calibration;
+  return open_device(parse_device_spec(c.device), oo);
+}
+
+SessionOptions session_options(const HwCommon& c, const std::string& verb) {
+  SessionOptions o;
+  o.verb = "hw " + verb;
+  o.servo.realtime = !c.no_realtime;
+  o.safety.require_deadman = c.require_deadman;
+  o.progress = !c.quiet;
+  return o;
+}
+
+Json identity_json(const DeviceIdentity& id) {
+  return Json{{"backend", id.backend},
+              {"config", id.config},
+              {"model", id.model},
+              {"vendor", id.vendor},
+              {"serial", id.serial},
+              {"driver_version", id.driver_version},
+              {"firmware_version", id.firmware_version},
+              {"api_version", id.api_version},
+              {"input_dof", id.input_dof},
+              {"output_dof", id.output_dof}};
+}
+
+Json timing_json(const TickStats& t) {
+  return Json{{"ticks", t.ticks},
+              {"overruns", t.overruns},
+              {"nominal_period_us", 1e6 * t.nominal_period_s},
+              {"period_mean_us", 1e6 * t.period_mean_s},
+              {"period_min_us", 1e6 * t.period_min_s},
+              {"period_p50_us", 1e6 * t.period_p50_s},
+              {"period_p99_us", 1e6 * t.period_p99_s},
+              {"period_max_us", 1e6 * t.period_max_s},
+              {"jitter_p50_us", 1e6 * t.jitter_p50_s},
+              {"jitter_p99_us", 1e6 * t.jitter_p99_s},
+              {"jitter_max_us", 1e6 * t.jitter_max_s},
+              {"work_p50_us", 1e6 * t.work_p50_s},
+              {"work_p99_us", 1e6 * t.work_p99_s},
+              {"work_max_us", 1e6 * t.work_max_s}};
+}
+
+Json session_json(const SessionResult& r) {
+  Json safety = Json::object();
+  for (const auto& [k, v] : r.safety_ticks) safety[k] = v;
+  Json errors = Json::object();
+  for (const auto& [k, v] : r.read_errors) errors[k] = v;
+  return Json{{"duration_s", r.duration_s},
+              {"ticks", r.ticks},
+              {"samples_dropped", r.dropped},
+              {"stop_reason", r.stop_reason},
+              {"zeroed_ticks", r.zeroed_ticks},
+              {"safety_ticks", safety},
+              {"read_errors", errors},
+              {"servo",
+               Json{{"sched_fifo", r.servo_report.sched_fifo},
+                    {"memory_locked", r.servo_report.memory_locked},
+                    {"note", r.servo_report.note}}},
+              {"timing", timing_json(r.timing)}};
+}
+
+namespace {
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+}  // namespace
+
+Json meta_json(const OpenedDevice& dev, const SessionResult& r,
+               const std::string& verb, const Json& extra) {
+  Json m{{"verb", "hw " + verb},
+         {"software", Json{{"name", "vmhaptics"}, {"version", VMH_VERSION}}},
+         {"date_utc", utc_now()},
+         {"device", identity_json(dev.backend->identity())},
+         {"calibration",
+          Json{{"state", calibration_state_name(dev.backend->calibration_state())},
+               {"source", dev.calibration_source}}},
+         {"session", session_json(r)}};
+  for (auto it = extra.begin(); it != extra.end(); ++it) m[it.key()] = it.value();
+  return m;
+}
+
+void write_meta(const std::string& out_dir, const Json& meta) {
+  if (out_dir.empty()) return;
+  report::write_file_in(out_dir, "meta.json", dump_readable(meta) + "\n");
+}
+
+void raise_if_cut_short(const SessionResult& r, const std::string& verb) {
+  if (r.signal != 0) {
+    throw SignalStop("hw " + verb + ": stopped by " + r.stop_reason.substr(7) +
+                         "; zero torque sent, trace kept up to t = " +
+                         std::to_string(r.duration_s) + " s",
+                     r.signal);
+  }
+  if (r.device_gone) {
+    throw std::runtime_error("hw " + verb + ": " + r.stop_reason +
+                             "; zero torque sent, trace kept up to t = " +
+                             std::to_string(r.duration_s) + " s");
+  }
+}
+
+}  // namespace vmh::cli
