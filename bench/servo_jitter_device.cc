@@ -51,4 +51,6 @@ std::unique_ptr<HapticDevice> make_jitter_device(double period_s,
   return std::make_unique<RotorDevice>(period_s, q0_device_rad);
 }
 
+std::string jitter_device_name() { return "a stand-in rotor model"; }
+
 }  // namespace vmh

@@ -1,9 +1,11 @@
-// The device servo_jitter drives: the one seam to change when the MuJoCo
-// emulator (sim/emulator.h) replaces the stand-in below.
+// The device servo_jitter drives: the MuJoCo emulator (sim/emulator.h,
+// servo_jitter_emulator.cc) when the testbed is built, else a stand-in
+// rotor model (servo_jitter_device.cc).
 #ifndef VMHAPTICS_BENCH_SERVO_JITTER_DEVICE_H_
 #define VMHAPTICS_BENCH_SERVO_JITTER_DEVICE_H_
 
 #include <memory>
+#include <string>
 
 #include "device/haptic_device.h"
 
@@ -13,6 +15,8 @@ namespace vmh {
 // convention, t1..t6, rad).
 std::unique_ptr<HapticDevice> make_jitter_device(double period_s,
                                                  const Joints& q0_device_rad);
+// what make_jitter_device makes, for the report
+std::string jitter_device_name();
 
 }  // namespace vmh
 

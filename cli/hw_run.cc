@@ -97,11 +97,17 @@ void hw_run(const HwRunOptions& o) {
   if (spec.backend == "emulator" && spec.argument.empty()) {
     common.device = "emulator:" + scene;
   }
+  const double duration_s = model->config().sim.duration_s;
+  if (spec.backend != "emulator") {
+    // no ground truth to measure claims on: the scene's model is not needed
+    // beyond its parameters, and it lets go of MuJoCo's control callback
+    model.reset();
+  }
   OpenedDevice dev = open_hw_device(common, "case", sets);
 
   SessionOptions so = session_options(o.common, "run");
   so.mode = HwMode::kRun;
-  so.duration_s = model->config().sim.duration_s;
+  so.duration_s = duration_s;
   so.out_dir = o.out;
   so.controller = params;
   so.reference = studies::reference_params(thesis_case, params);
@@ -118,7 +124,7 @@ void hw_run(const HwRunOptions& o) {
                {"session", session_json(r)}};
   bool claims_pass = true;
   std::string failed;
-  if (dev.emulator != nullptr && !r.samples.empty()) {
+  if (dev.emulator != nullptr && model && !r.samples.empty()) {
     std::vector<sim::TraceRow> rows;
     rows.reserve(r.samples.size());
     for (const HwSample& h : r.samples) rows.push_back(trace_row(h));

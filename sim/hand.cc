@@ -60,12 +60,18 @@ void register_hand(const mjData* d, SimHand* hand, const std::string& source) {
 
 void unregister_hand(const mjData* d) {
   std::lock_guard<std::mutex> lock(g_registry_mutex);
+  bool any = false;
   for (Slot& s : g_slots) {
     if (s.data.load(std::memory_order_acquire) == d) {
       s.data.store(nullptr, std::memory_order_release);
       s.hand.store(nullptr, std::memory_order_release);
     }
+    any = any || s.data.load(std::memory_order_acquire) != nullptr;
   }
+  // the last hand gone: hand the callback back, so that other code in the
+  // process (another copy of this library inside a plugin, e.g. the test
+  // libHD.so over the emulator) may install its own
+  if (!any && mjcb_control == hand_control_callback) mjcb_control = nullptr;
 }
 
 }  // namespace

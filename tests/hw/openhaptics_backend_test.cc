@@ -35,6 +35,7 @@ struct Hooks {
   FakeHdVec3Fn position_mm = nullptr;
   FakeHdJointsFn joints_rad = nullptr;
   FakeHdInFrameFn in_frame = nullptr;
+  FakeHdTrueJointsFn true_q_dh = nullptr;
 
   static const Hooks& get() {
     static const Hooks h = [] {
@@ -50,6 +51,8 @@ struct Hooks {
       k.position_mm = reinterpret_cast<FakeHdVec3Fn>(sym("fake_hd_position_mm"));
       k.joints_rad = reinterpret_cast<FakeHdJointsFn>(sym("fake_hd_model_joints_rad"));
       k.in_frame = reinterpret_cast<FakeHdInFrameFn>(sym("fake_hd_in_frame"));
+      k.true_q_dh =
+          reinterpret_cast<FakeHdTrueJointsFn>(sym("fake_hd_true_q_dh_rad"));
       return k;
     }();
     return h;
@@ -259,6 +262,10 @@ TEST_F(OpenHapticsBackendTest, JointAnglesPassThroughWithJoint3Absolute) {
   auto b = open("");
   RecordingLoop loop;
   run(b.get(), &loop, 5);
+  // nobody holds it and no torque goes out: the model is at rest, so its
+  // state now is its state at the last reading
+  double q_dh[6];
+  const bool truth = Hooks::get().true_q_dh(q_dh) == 1;
   b->stop();
   const DeviceState& s = loop.last;
   // the device's own transform (its formula, t3 absolute) is what the
@@ -272,10 +279,20 @@ TEST_F(OpenHapticsBackendTest, JointAnglesPassThroughWithJoint3Absolute) {
              base_to_device_rotation(pose.R_base))
                 .norm(),
             1e-9);
-  // the test model's pose has t3 = 0.7 rad with t2 = 0.2: an elbow angle of
-  // 0.5 rad in DH terms
-  EXPECT_NEAR(s.q_device_rad[2], 0.7, 1e-3);
-  EXPECT_NEAR(device_to_dh_joints(s.q_device_rad)[2], 0.5, 1e-3);
+  // joint 3 arrives absolute: t3 = q2 + q3 of the model's own DH state
+  // (MuJoCo's, over the emulator; the rigid model's known pose otherwise),
+  // to the encoders' resolution
+  if (truth) {
+    const double count = 2.0 * 3.14159265358979323846 / 15000.0;
+    EXPECT_NEAR(s.q_device_rad[2], q_dh[1] + q_dh[2], 2.0 * count);
+    EXPECT_NEAR(s.q_device_rad[1], q_dh[1], 2.0 * count);
+    EXPECT_NEAR(s.q_device_rad[0], -q_dh[0], 2.0 * count);
+  } else {
+    // the rigid model's pose has t3 = 0.7 rad with t2 = 0.2: an elbow
+    // angle of 0.5 rad in DH terms
+    EXPECT_NEAR(s.q_device_rad[2], 0.7, 1e-3);
+    EXPECT_NEAR(device_to_dh_joints(s.q_device_rad)[2], 0.5, 1e-3);
+  }
 }
 
 TEST_F(OpenHapticsBackendTest, PositiveMotorTorqueTurnsTheJointPositive) {

@@ -111,4 +111,6 @@ std::unique_ptr<HapticDevice> fake_hd_make_device(const std::string& config) {
   return std::make_unique<RigidOmni>(docked, buttons);
 }
 
+bool fake_hd_true_q_dh(const HapticDevice&, Joints*) { return false; }
+
 }  // namespace vmh::fake_hd

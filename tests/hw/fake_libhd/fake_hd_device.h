@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "controller/types.h"
 #include "device/haptic_device.h"
 
 namespace vmh::fake_hd {
@@ -15,7 +16,16 @@ namespace vmh::fake_hd {
 // the library itself does not handle ("docked", "button1", "button2"); an
 // unknown one throws std::invalid_argument naming it. The device runs in
 // real time from its creation.
+//
+// Two implementations, chosen by the build: over the MuJoCo emulator
+// (fake_hd_emulator_device.cc, nobody holding the stylus, or the "tour"
+// token for the scripted hand) when the testbed is built, and a small rigid
+// model (fake_hd_device.cc) in a build without MuJoCo.
 std::unique_ptr<HapticDevice> fake_hd_make_device(const std::string& config);
+
+// The model's own joint angles, DH convention (rad), independent of the
+// sensor path: the emulator's MuJoCo state. false for a model that has none.
+bool fake_hd_true_q_dh(const HapticDevice& device, Joints* q_dh_rad);
 
 }  // namespace vmh::fake_hd
 

@@ -24,6 +24,8 @@ typedef void (*FakeHdCountersFn)(FakeHdCounters* out);
 typedef void (*FakeHdVec3Fn)(double* out3);
 // the model's joint angles at the last frame, rad (device convention)
 typedef void (*FakeHdJointsFn)(double* out6);
+// the model's own DH joint angles (rad, MuJoCo's state): 1 if it has them
+typedef int (*FakeHdTrueJointsFn)(double* out6);
 // 1 on the scheduler thread between hdBeginFrame and hdEndFrame
 typedef int (*FakeHdInFrameFn)();
 

@@ -594,6 +594,14 @@ FAKE_HD_EXPORT void fake_hd_model_joints_rad(double* out6) {
   for (int i = 0; i < 6; ++i) out6[i] = g_snap.q[i];
 }
 
+FAKE_HD_EXPORT int fake_hd_true_q_dh_rad(double* out6) {
+  std::lock_guard<std::mutex> lock(g_mu);
+  vmh::Joints q;
+  if (!g_dev || !vmh::fake_hd::fake_hd_true_q_dh(*g_dev, &q)) return 0;
+  for (int i = 0; i < 6; ++i) out6[i] = q[i];
+  return 1;
+}
+
 FAKE_HD_EXPORT int fake_hd_in_frame() {
   const bool sched = on_scheduler();
   std::lock_guard<std::mutex> lock(g_mu);
