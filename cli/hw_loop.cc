@@ -47,6 +47,7 @@ bool HwLoop::tick(double now_s) noexcept {
   s.has_truth = emulator_ != nullptr;
   if (emulator_ != nullptr) s.truth = emulator_->truth();
   ring_.push(s);
+  latest_.write(s);
   ticks_.store(ticks_.load(std::memory_order_relaxed) + 1,
                std::memory_order_release);
   return s.t_s < o_.duration_s;

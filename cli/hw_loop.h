@@ -1,7 +1,8 @@
 // The servo loop of an hw session (cli/hw_session.h): each tick reads the
 // device through the safety layer and the reading guard, runs the
 // controller (run), a torque pulse (motor-test) or nothing (record, zero
-// torque), and pushes one HwSample into a ring for the recorder. Everything
+// torque), pushes one HwSample into a ring for the recorder and publishes
+// it as the latest state for other threads. Everything
 // it touches is allocated before the first tick; tick() allocates nothing
 // and takes no lock (tests/cli/hw_loop_test.cc).
 #ifndef VMHAPTICS_CLI_HW_LOOP_H_
@@ -11,6 +12,7 @@
 #include <memory>
 
 #include "cli/hw_session.h"
+#include "device/seqlock.h"
 #include "device/servo_loop.h"
 #include "device/spsc_ring.h"
 
@@ -38,7 +40,11 @@ class HwLoop final : public ServoLoop {
   // the device chain: servo_tick -> SafetyLayer -> ReadingGuard -> raw
   bool tick(double now_s) noexcept override;
 
+  // every tick, in order, for the one recorder thread
   SpscRing<HwSample>& ring() { return ring_; }
+  // the latest tick, for any other thread (a viewer, a monitor): never
+  // blocks the loop
+  HwSample latest() const { return latest_.read(); }
   SafetyLayer& safety() { return safety_; }
   long ticks() const { return ticks_.load(std::memory_order_acquire); }
 
@@ -50,6 +56,7 @@ class HwLoop final : public ServoLoop {
   std::unique_ptr<Controller> reference_;
   ControlOutput ref_out_;
   SpscRing<HwSample> ring_;
+  Seqlock<HwSample> latest_;
   sim::Emulator* emulator_;
   HwSample sample_;
   bool started_ = false;

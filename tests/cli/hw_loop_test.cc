@@ -52,6 +52,8 @@ TEST(HwLoop, RecordSendsZeroAndKeepsEveryTick) {
   }
   EXPECT_EQ(n, 100);
   EXPECT_EQ(loop.ticks(), 100);
+  // the latest state is the last tick's
+  EXPECT_NEAR(loop.latest().t_s, 0.099, 1e-12);
 }
 
 TEST(HwLoop, RunSendsTheControllersTorqueOnceTheRampIsDone) {

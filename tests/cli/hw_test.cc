@@ -172,6 +172,18 @@ TEST(HwCli, UnknownDeviceIsNamed) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
+TEST(HwCli, BadEmulatorOptionsAreNamed) {
+  const auto f = run("hw probe --device emulator --fault bogus@1");
+  EXPECT_EQ(f.exit_code, 2);
+  EXPECT_NE(f.err.find("bogus"), std::string::npos) << f.err;
+  const auto h = run("hw probe --device emulator --hand juggle");
+  EXPECT_EQ(h.exit_code, 2);
+  EXPECT_NE(h.err.find("juggle"), std::string::npos) << h.err;
+  const auto s = run("hw probe --device emulator:nosuch_case");
+  EXPECT_EQ(s.exit_code, 2);
+  EXPECT_NE(s.err.find("nosuch_case"), std::string::npos) << s.err;
+}
+
 TEST(HwCli, MissingLibHDIsNamedAndNothingIsWritten) {
   const fs::path out = fresh_dir("nolib");
   const auto r = run("hw record --device openhaptics --out " + out.string(),
