@@ -56,7 +56,7 @@ void probe(const RecordOptions& o) {
            {"calibration",
             Json{{"state", calibration_state_name(dev.backend->calibration_state())},
                  {"source", dev.calibration_source}}}};
-  const double rate = r.duration_s > 0.0 ? (r.ticks - 1) / r.duration_s : 0.0;
+  const double rate = r.duration_s > 0.0 ? static_cast<double>(r.ticks - 1) / r.duration_s : 0.0;
   out["rate_Hz"] = rate;
   if (const HwSample* s = last_reading(r)) {
     out["q_device_rad"] = joints_json(s->state.q_device_rad);

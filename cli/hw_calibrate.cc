@@ -14,7 +14,6 @@
 // update (hdUpdateCalibration) and reports the state before and after.
 #include <algorithm>
 #include <cmath>
-#include <ctime>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -23,6 +22,7 @@
 #include "cli/hw.h"
 #include "cli/hw_calibration_store.h"
 #include "cli/hw_common.h"
+#include "controller/device_frame.h"
 #include "controller/omni_params.h"
 #include "hw/openhaptics/openhaptics_backend.h"
 #include "sim/emulator.h"
@@ -36,22 +36,12 @@ struct CalibrateOptions {
   double sweep_s = 10.0;
 };
 
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
-// The gimbal joints' ends, device convention (t4 = -q4, t5 = q5, t6 = -q6,
-// controller/device_frame.h), rad
+// The gimbal joints' ends, device convention, rad
 std::array<std::pair<double, double>, 3> gimbal_ranges() {
-  const OmniParams p;
-  return {std::make_pair(-p.joint_upper_rad[3], -p.joint_lower_rad[3]),
-          std::make_pair(p.joint_lower_rad[4], p.joint_upper_rad[4]),
-          std::make_pair(-p.joint_upper_rad[5], -p.joint_lower_rad[5])};
+  Joints lo, hi;
+  device_joint_ranges(OmniParams(), &lo, &hi);
+  return {std::make_pair(lo[3], hi[3]), std::make_pair(lo[4], hi[4]),
+          std::make_pair(lo[5], hi[5])};
 }
 
 void calibrate_openhaptics(OpenedDevice* dev) {
@@ -124,7 +114,7 @@ void calibrate(const CalibrateOptions& o) {
   }
   hw::EncoderCounts mean{};
   for (int i = 0; i < 3; ++i) {
-    mean[i] = static_cast<std::int32_t>(std::lround(sum[i] / docked));
+    mean[i] = static_cast<std::int32_t>(std::lround(sum[i] / static_cast<double>(docked)));
   }
   const Vec3 inkwell(sim::kInkwellDevice_rad[0], sim::kInkwellDevice_rad[1],
                      sim::kInkwellDevice_rad[2]);

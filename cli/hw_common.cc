@@ -99,7 +99,6 @@ Json session_json(const SessionResult& r) {
               {"timing", timing_json(r.timing)}};
 }
 
-namespace {
 std::string utc_now() {
   const std::time_t t = std::time(nullptr);
   std::tm tm{};
@@ -108,7 +107,6 @@ std::string utc_now() {
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
 }
-}  // namespace
 
 Json meta_json(const OpenedDevice& dev, const SessionResult& r,
                const std::string& verb, const Json& extra) {

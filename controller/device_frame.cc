@@ -24,6 +24,19 @@ Joints dh_to_device_joints(const Joints& q) {
   return t;
 }
 
+void device_joint_ranges(const OmniParams& params, Joints* lower_device_rad,
+                         Joints* upper_device_rad) {
+  Joints lo_dh, hi_dh;
+  for (int i = 0; i < 6; ++i) {
+    lo_dh[i] = params.joint_lower_rad[static_cast<std::size_t>(i)];
+    hi_dh[i] = params.joint_upper_rad[static_cast<std::size_t>(i)];
+  }
+  const Joints a = dh_to_device_joints(lo_dh);
+  const Joints b = dh_to_device_joints(hi_dh);
+  *lower_device_rad = a.cwiseMin(b);
+  *upper_device_rad = a.cwiseMax(b);
+}
+
 Vec3 dh_to_motor_torques(const Vec3& tau) {
   return Vec3(-tau[0], tau[1] - tau[2], tau[2]);
 }

@@ -37,6 +37,11 @@ namespace vmh {
 Joints device_to_dh_joints(const Joints& q_device);
 Joints dh_to_device_joints(const Joints& q_dh);
 
+// OmniParams' joint ranges (DH) in the device convention, rad: each
+// device joint's lower and upper end (t3's is q2 + q3 at the DH ends).
+void device_joint_ranges(const OmniParams& params, Joints* lower_device_rad,
+                         Joints* upper_device_rad);
+
 // Torques on the three actuated joints: DH joints q1..q3 <-> motors t1..t3,
 // N m. The motors drive t1..t3 (t3 the absolute forearm angle), so by equal
 // power (tau_dh . dq = tau_motor . dt under the joint map above) the motor

@@ -78,13 +78,8 @@ hw::OmniCalibration factory_for(const std::string& serial,
   const double base_counts[3] = {std::round(-0.23 / step),
                                  std::round(0.37 / step), 0.0};
   hw::OmniCalibration cal;
-  Joints lo_dh, hi_dh;
-  for (int i = 0; i < 6; ++i) {
-    lo_dh[i] = omni.joint_lower_rad[static_cast<std::size_t>(i)];
-    hi_dh[i] = omni.joint_upper_rad[static_cast<std::size_t>(i)];
-  }
-  const Joints a = dh_to_device_joints(lo_dh);
-  const Joints b = dh_to_device_joints(hi_dh);
+  Joints a, b;
+  device_joint_ranges(omni, &a, &b);
   const double levels = std::ldexp(1.0, omni.gimbal_pot_bits);
   for (int i = 0; i < 3; ++i) {
     const auto k = static_cast<std::size_t>(i);

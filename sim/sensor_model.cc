@@ -12,13 +12,8 @@ SensorModel::SensorModel(const OmniParams& omni, bool enabled)
   // joint ranges are given in the DH convention; the device's gimbal angles
   // are the DH ones with t4 = -q4, t6 = -q6, and the ranges are symmetric,
   // so the span is the same; the lower bound is mapped explicitly
-  Joints lo_dh, hi_dh;
-  for (int i = 0; i < 6; ++i) {
-    lo_dh[i] = omni.joint_lower_rad[static_cast<std::size_t>(i)];
-    hi_dh[i] = omni.joint_upper_rad[static_cast<std::size_t>(i)];
-  }
-  const Joints a = dh_to_device_joints(lo_dh);
-  const Joints b = dh_to_device_joints(hi_dh);
+  Joints a, b;
+  device_joint_ranges(omni, &a, &b);
   for (int i = 0; i < 6; ++i) {
     const auto k = static_cast<std::size_t>(i);
     if (i < 3) {

@@ -128,5 +128,23 @@ TEST(DeviceFrame, DeviceJacobianByChainRuleMatchesDifferences) {
   }
 }
 
+// OmniParams' DH ranges in the device convention, worked out by hand from
+// the joint map (t1 = -q1, t3 = q2 + q3, t4 = -q4, t6 = -q6)
+TEST(DeviceJointRanges, FollowTheJointMap) {
+  const OmniParams p;
+  Joints lo, hi;
+  device_joint_ranges(p, &lo, &hi);
+  EXPECT_DOUBLE_EQ(lo[0], -p.joint_upper_rad[0]);
+  EXPECT_DOUBLE_EQ(hi[0], -p.joint_lower_rad[0]);
+  EXPECT_DOUBLE_EQ(lo[1], p.joint_lower_rad[1]);
+  EXPECT_DOUBLE_EQ(hi[1], p.joint_upper_rad[1]);
+  EXPECT_DOUBLE_EQ(lo[2], p.joint_lower_rad[1] + p.joint_lower_rad[2]);
+  EXPECT_DOUBLE_EQ(hi[2], p.joint_upper_rad[1] + p.joint_upper_rad[2]);
+  EXPECT_DOUBLE_EQ(lo[3], -p.joint_upper_rad[3]);
+  EXPECT_DOUBLE_EQ(hi[4], p.joint_upper_rad[4]);
+  EXPECT_DOUBLE_EQ(lo[5], -p.joint_upper_rad[5]);
+  EXPECT_DOUBLE_EQ(hi[5], -p.joint_lower_rad[5]);
+}
+
 }  // namespace
 }  // namespace vmh

@@ -22,25 +22,15 @@
 #include "sim/closed_loop.h"
 #include "sim/emulator.h"
 #include "tests/device/safety_rig.h"
+#include "tests/support/wait.h"
 
 namespace vmh::sim {
 namespace {
 
 using vmh::testing::fd_jacobian;
+using vmh::testing::sleep_s;
+using vmh::testing::wait_for;
 using vmh::testing::quiet;
-
-void sleep_s(double s) {
-  std::this_thread::sleep_for(std::chrono::duration<double>(s));
-}
-
-bool wait_for(const std::function<bool()>& done, double limit_s) {
-  const double end = monotonic_now_s() + limit_s;
-  while (monotonic_now_s() < end) {
-    if (done()) return true;
-    sleep_s(1e-3);
-  }
-  return done();
-}
 
 // the wrist-centre force (N, norm) that motor torques make at q (DH), by
 // the finite-difference Jacobian: tau_dh = J^T F
@@ -150,10 +140,14 @@ TEST(EmulatorSafety, ForceClampTriggersAndRecovers) {
   sleep_s(0.05);
   rig.command(torque_for(rig.q_dh(), 5.0));  // 5 N asked; 3.3 N is the limit
   ASSERT_TRUE(rig.wait_flag(kSafetyForceClamped | kSafetyTorqueClamped, true, 1.0));
-  sleep_s(0.01);
-  const double F = force_N(rig.q_dh(), rig.held());
+  // the clamped torque reaches the motors: a force near the limit, not a
+  // cut and not more
+  double F = 0.0;
+  EXPECT_TRUE(wait_for([&] {
+    F = force_N(rig.q_dh(), rig.held());
+    return F > 2.0;
+  }, 0.5));
   EXPECT_LE(F, SafetyParams().max_force_N * 1.05);
-  EXPECT_GT(F, 2.0);  // clamped, not cut
   rig.command(kSmall);
   ASSERT_TRUE(rig.wait_flag(kSafetyForceClamped | kSafetyTorqueClamped, false, 1.0));
   ASSERT_TRUE(wait_for([&] { return holds(rig.held(), kSmall); }, 1.0));
@@ -219,9 +213,10 @@ TEST(EmulatorSafety, VelocityCutOnAFlingResumesWhenCaught) {
   // some travel
   EXPECT_GT(std::abs(rig.q_dh()[0] - q1_rest), 0.005);
   rig.command(kSmall);
-  sleep_s(0.005);
+  // while the cut lasts the motors come to hold nothing (the emulator
+  // applies a command from its next period, after its delay line)
   if (rig.has(kSafetyVelocityExceeded)) {
-    EXPECT_TRUE(rig.held().isZero());
+    EXPECT_TRUE(wait_for([&] { return rig.held().isZero(); }, 0.1));
   }
   rig.emu().set_hand_program(HandProgram::kCase);
   ASSERT_TRUE(wait_for(
@@ -241,8 +236,8 @@ TEST(EmulatorSafety, ThermalWarmHotCoolRecover) {
   rig.command(big);
   ASSERT_TRUE(rig.wait_flag(kSafetyMotorWarm, true, 2.0));
   ASSERT_TRUE(rig.wait_flag(kSafetyMotorHot, true, 2.0));
-  sleep_s(0.005);
-  EXPECT_TRUE(rig.held().isZero());
+  // the cut reaches the motors within the emulator's next periods
+  EXPECT_TRUE(wait_for([&] { return rig.held().isZero(); }, 0.1));
   // cooled below the resume level: the torque comes back
   rig.command(kSmall);
   ASSERT_TRUE(rig.wait_flag(kSafetyMotorHot, false, 3.0));
@@ -287,8 +282,8 @@ TEST(EmulatorSafety, DockedCutsUndockedRestores) {
   ASSERT_TRUE(wait_for([&] { return holds(rig.held(), kSmall); }, 1.0));
   rig.emu().set_hand_program(HandProgram::kDock);
   ASSERT_TRUE(rig.wait_flag(kSafetyDocked, true, 8.0));
-  sleep_s(0.005);
-  EXPECT_TRUE(rig.held().isZero());
+  // the cut reaches the motors within the emulator's next periods
+  EXPECT_TRUE(wait_for([&] { return rig.held().isZero(); }, 0.1));
   EXPECT_TRUE(rig.emu().truth().docked);
   rig.emu().set_hand_program(HandProgram::kTour);  // out of the inkwell
   ASSERT_TRUE(rig.wait_flag(kSafetyDocked, false, 3.0));
@@ -301,8 +296,8 @@ TEST(EmulatorSafety, DeadmanButtonGatesForce) {
   Rig rig(HandProgram::kCase, p);
   rig.command(kSmall);
   ASSERT_TRUE(rig.wait_flag(kSafetyDeadmanReleased, true, 1.0));
-  sleep_s(0.005);
-  EXPECT_TRUE(rig.held().isZero());
+  // the cut reaches the motors within the emulator's next periods
+  EXPECT_TRUE(wait_for([&] { return rig.held().isZero(); }, 0.1));
   rig.emu().press_buttons(kButton1);
   ASSERT_TRUE(rig.wait_flag(kSafetyDeadmanReleased, false, 1.0));
   ASSERT_TRUE(wait_for([&] { return holds(rig.held(), kSmall); }, 1.0));

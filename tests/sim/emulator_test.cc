@@ -21,6 +21,7 @@
 #include "sim/closed_loop.h"
 #include "sim/sensor_model.h"
 #include "tests/support/alloc_counter.h"
+#include "tests/support/wait.h"
 
 namespace vmh::sim {
 namespace {
@@ -34,19 +35,8 @@ EmulatorOptions options(HandProgram p) {
   return o;
 }
 
-void sleep_s(double s) {
-  std::this_thread::sleep_for(std::chrono::duration<double>(s));
-}
-
-// polls `done` every millisecond for at most limit_s; whether it came true
-bool wait_for(const std::function<bool()>& done, double limit_s) {
-  const double end = monotonic_now_s() + limit_s;
-  while (monotonic_now_s() < end) {
-    if (done()) return true;
-    sleep_s(1e-3);
-  }
-  return done();
-}
+using vmh::testing::sleep_s;
+using vmh::testing::wait_for;
 
 // a reading, retried for up to a second: a loaded machine can delay the
 // physics thread by the three periods after which a read times out
