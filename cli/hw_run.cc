@@ -94,7 +94,12 @@ void hw_run(const HwRunOptions& o) {
   // the emulator plays the scene itself, held by the scene's hand script
   HwCommon common = o.common;
   const DeviceSpec spec = parse_device_spec(common.device);
-  if (spec.backend == "emulator" && spec.argument.empty()) {
+  if (spec.backend == "emulator") {
+    if (!spec.argument.empty()) {
+      throw UsageError("hw run: the emulator plays the run's own scene; give "
+                       "it as the target, not in --device (" + common.device +
+                       ")");
+    }
     common.device = "emulator:" + scene;
   }
   const double duration_s = model->config().sim.duration_s;

@@ -200,18 +200,22 @@ SessionResult run_session(OpenedDevice* dev, const SessionOptions& o) {
   HwLoop loop(backend.device(), o, omni, dev->emulator);
 
   SessionResult r;
+  StopSignals signals;
+  // started before anything is written: a device that cannot start leaves
+  // no file behind (the first ticks wait in the ring meanwhile)
+  r.servo_report = backend.start(&loop, o.servo);
   std::ofstream trace;
   if (!o.out_dir.empty()) {
-    fs::create_directories(o.out_dir);
+    std::error_code ec;
+    fs::create_directories(o.out_dir, ec);
     r.trace_path = (fs::path(o.out_dir) / "trace.csv").string();
-    trace.open(r.trace_path, std::ios::out | std::ios::trunc);
-    if (!trace) {
-      throw std::runtime_error(o.verb + ": cannot write " + r.trace_path);
+    if (!ec) trace.open(r.trace_path, std::ios::out | std::ios::trunc);
+    if (ec || !trace) {
+      backend.stop();
+      throw std::runtime_error(o.verb + ": cannot write " + r.trace_path +
+                               (ec ? " (" + ec.message() + ")" : ""));
     }
   }
-
-  StopSignals signals;
-  r.servo_report = backend.start(&loop, o.servo);
 
   bool header = false;
   std::uint32_t present = 0;

@@ -184,6 +184,20 @@ TEST(HwCli, BadEmulatorOptionsAreNamed) {
   EXPECT_NE(s.err.find("nosuch_case"), std::string::npos) << s.err;
 }
 
+TEST(HwCli, UnwritableOutputIsNamedAndTheDeviceStopped) {
+  const auto r = run("hw record --device emulator --duration 1 --quiet "
+                     "--out /proc/vmh_no_such_dir", kEnv);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("/proc/vmh_no_such_dir"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+TEST(HwCli, RunOnTheEmulatorTakesTheSceneAsTarget) {
+  const auto r = run("hw run --device emulator:case2 case1", kEnv);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("emulator:case2"), std::string::npos) << r.err;
+}
+
 TEST(HwCli, MissingLibHDIsNamedAndNothingIsWritten) {
   const fs::path out = fresh_dir("nolib");
   const auto r = run("hw record --device openhaptics --out " + out.string(),
