@@ -118,6 +118,16 @@ Json meta_json(const OpenedDevice& dev, const SessionResult& r,
           Json{{"state", calibration_state_name(dev.backend->calibration_state())},
                {"source", dev.calibration_source}}},
          {"session", session_json(r)}};
+  // the periods' histogram, up to its last non-empty bin
+  Json counts = Json::array();
+  std::size_t last = 0;
+  for (std::size_t i = 0; i < r.timing.histogram.size(); ++i) {
+    if (r.timing.histogram[i] != 0) last = i + 1;
+  }
+  for (std::size_t i = 0; i < last; ++i) counts.push_back(r.timing.histogram[i]);
+  m["period_histogram"] = Json{{"bin_us", 1e6 * r.timing.histogram_bin_s},
+                               {"counts", counts},
+                               {"last_bin_holds_the_rest", true}};
   for (auto it = extra.begin(); it != extra.end(); ++it) m[it.key()] = it.value();
   return m;
 }

@@ -146,6 +146,10 @@ TEST(HwCli, RecordWritesRunsColumnsAndMeta) {
   EXPECT_FALSE(m.at("software").at("version").get<std::string>().empty());
   EXPECT_EQ(m.at("session").at("stop_reason"), "duration");
   EXPECT_TRUE(m.at("session").at("timing").contains("jitter_p99_us"));
+  // the periods' histogram counts every period but the first tick's
+  long periods = 0;
+  for (const auto& n : m.at("period_histogram").at("counts")) periods += n.get<long>();
+  EXPECT_EQ(periods, m.at("session").at("timing").at("ticks").get<long>() - 1);
 }
 
 TEST(HwCli, MotorTestMovesTheJointWithTheTorquesSign) {
