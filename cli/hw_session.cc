@@ -223,6 +223,7 @@ SessionResult run_session(OpenedDevice* dev, const SessionOptions& o) {
   HwSample s;
   double comm_lost_since = -1.0;
   double next_progress_s = 1.0;
+  bool write_failed = false;
   auto drain = [&]() {
     rows.clear();
     while (loop.ring().pop(&s)) {
@@ -256,10 +257,13 @@ SessionResult run_session(OpenedDevice* dev, const SessionOptions& o) {
     if (trace && !rows.empty()) {
       trace << rows;
       trace.flush();
+      // a full disk: stop rather than drive the device unrecorded
+      if (!trace) write_failed = true;
     }
   };
 
-  while (backend.running() && !signals.requested() && !r.device_gone) {
+  while (backend.running() && !signals.requested() && !r.device_gone &&
+         !write_failed) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     drain();
     if (o.on_poll) o.on_poll(r.duration_s);
@@ -280,6 +284,11 @@ SessionResult run_session(OpenedDevice* dev, const SessionOptions& o) {
                     (r.signal == SIGINT ? "SIGINT" : r.signal == SIGTERM ? "SIGTERM" : "?");
   } else if (r.stop_reason.empty()) {
     r.stop_reason = r.duration_s >= o.duration_s ? "duration" : "loop_ended";
+  }
+  if (write_failed) {
+    throw std::runtime_error(o.verb + ": writing " + r.trace_path +
+                             " failed (disk full?); the device was stopped "
+                             "at zero torque");
   }
   r.ticks = loop.ticks();
   r.dropped = loop.ring().dropped();

@@ -196,6 +196,20 @@ TEST(HwCli, UnwritableOutputIsNamedAndTheDeviceStopped) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
+// a disk that fills up mid-session (trace.csv is /dev/full): the session
+// stops at once with the cause named, rather than drive the device
+// unrecorded
+TEST(HwCli, AFullDiskStopsTheSession) {
+  const fs::path out = fresh_dir("full");
+  fs::create_directories(out);
+  fs::create_symlink("/dev/full", out / "trace.csv");
+  const auto r = run("hw record --device emulator --duration 20 --quiet --out " +
+                         out.string(), kEnv);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("trace.csv"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("failed"), std::string::npos) << r.err;
+}
+
 TEST(HwCli, RunOnTheEmulatorTakesTheSceneAsTarget) {
   const auto r = run("hw run --device emulator:case2 case1", kEnv);
   EXPECT_EQ(r.exit_code, 2);
