@@ -20,4 +20,11 @@ DeviceError HapticDevice::read_state(DeviceState* state) noexcept {
   return e;
 }
 
+DeviceError HapticDevice::joints_of_state(Joints* q_device_rad) noexcept {
+  DeviceState state;
+  const DeviceError e = read_state(&state);
+  if (e == DeviceError::kOk) *q_device_rad = state.q_device_rad;
+  return e;
+}
+
 }  // namespace vmh

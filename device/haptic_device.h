@@ -50,6 +50,11 @@ class HapticDevice {
   // Torques for motors t1..t3 (N m), held until the next call (zero-order
   // hold). A non-finite entry must make the device send zero torque.
   virtual DeviceError write_motor_torques(const Vec3& tau_motor_Nm) noexcept = 0;
+
+ protected:
+  // read_joints() for a device whose own read is read_state() (the
+  // decorators, the emulator, the backends): the joints of one read_state()
+  DeviceError joints_of_state(Joints* q_device_rad) noexcept;
 };
 
 }  // namespace vmh

@@ -35,10 +35,7 @@ void ReadingGuard::reset() noexcept {
 }
 
 DeviceError ReadingGuard::read_joints(Joints* q_device_rad) noexcept {
-  DeviceState state;
-  const DeviceError err = read_state(&state);
-  if (err == DeviceError::kOk) *q_device_rad = state.q_device_rad;
-  return err;
+  return joints_of_state(q_device_rad);
 }
 
 DeviceError ReadingGuard::read_state(DeviceState* state) noexcept {

@@ -181,36 +181,34 @@ bool SafetyLayer::service_watchdog(double now_s) noexcept {
 }
 
 DeviceError SafetyLayer::read_joints(Joints* q_device_rad) noexcept {
-  DeviceState state;
-  const DeviceError err = read_state(&state);
-  if (err == DeviceError::kOk) *q_device_rad = state.q_device_rad;
-  return err;
+  return joints_of_state(q_device_rad);
 }
 
 DeviceError SafetyLayer::read_state(DeviceState* state) noexcept {
   status_ = kSafetyOk;
-  // the time step since the last read: stamped by the caller, else by the
-  // device's own clock (below), else one servo period
-  dt_s_ = params_.servo_period_s;
-  const bool caller_stamped = stamped_;
-  if (stamped_) {
-    if (have_stamp_ && std::isfinite(stamp_s_ - last_stamp_s_) &&
-        stamp_s_ > last_stamp_s_) {
-      dt_s_ = stamp_s_ - last_stamp_s_;
-    }
-    if (std::isfinite(stamp_s_)) {
-      last_stamp_s_ = stamp_s_;
-      have_stamp_ = true;
-    }
-  }
-
   DeviceError err = inner_->read_state(state);
   const Joints q = state->q_device_rad;
   if (err == DeviceError::kOk && !q.allFinite()) err = DeviceError::kSensorFault;
+
+  // the time step since the last read: between the caller's stamps, else
+  // the device's own clock (a good reading's), else one servo period
+  double stamp_s = std::nan("");
+  if (stamped_) {
+    stamp_s = stamp_s_;
+  } else if (err == DeviceError::kOk && state->has(kStateTimestamp)) {
+    stamp_s = state->timestamp_s;
+  }
+  dt_s_ = params_.servo_period_s;
+  if (std::isfinite(stamp_s)) {
+    if (have_stamp_ && stamp_s > last_stamp_s_) dt_s_ = stamp_s - last_stamp_s_;
+    last_stamp_s_ = stamp_s;
+    have_stamp_ = true;
+  }
+  // the motors held the last torque over the interval that just ended
+  update_heat(tau_prev_);
+
   if (err != DeviceError::kOk) {
     state->present = 0;
-    // the motors held the last torque over the interval that just ended
-    update_heat(tau_prev_);
     have_reading_ = false;
     have_previous_ = false;  // nothing to take a velocity from
     good_reads_ = 0;
@@ -220,16 +218,6 @@ DeviceError SafetyLayer::read_state(DeviceState* state) noexcept {
     return err;
   }
   failed_reads_ = 0;
-  // the device's own clock, when the caller gave none
-  if (!caller_stamped && state->has(kStateTimestamp) &&
-      std::isfinite(state->timestamp_s)) {
-    if (have_stamp_ && state->timestamp_s > last_stamp_s_) {
-      dt_s_ = state->timestamp_s - last_stamp_s_;
-    }
-    last_stamp_s_ = state->timestamp_s;
-    have_stamp_ = true;
-  }
-  update_heat(tau_prev_);
   // the switches, where the device reports them (set_inputs() otherwise)
   if (state->has(kStateInkwell)) docked_ = state->docked;
   if (state->has(kStateButtons) && params_.deadman_buttons != 0) {

@@ -420,10 +420,7 @@ DeviceError Emulator::read_state(DeviceState* state) noexcept {
 }
 
 DeviceError Emulator::read_joints(Joints* q_device_rad) noexcept {
-  DeviceState s;
-  const DeviceError e = read_state(&s);
-  if (e == DeviceError::kOk) *q_device_rad = s.q_device_rad;
-  return e;
+  return joints_of_state(q_device_rad);
 }
 
 DeviceError Emulator::write_motor_torques(const Vec3& tau_motor_Nm) noexcept {

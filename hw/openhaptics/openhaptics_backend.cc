@@ -297,10 +297,7 @@ HDCallbackCode OpenHapticsBackend::zero_callback(void* self) noexcept {
 
 DeviceError OpenHapticsBackend::FrameDevice::read_joints(
     Joints* q_device_rad) noexcept {
-  DeviceState s;
-  const DeviceError e = read_state(&s);
-  if (e == DeviceError::kOk) *q_device_rad = s.q_device_rad;
-  return e;
+  return joints_of_state(q_device_rad);
 }
 
 DeviceError OpenHapticsBackend::FrameDevice::read_state(
