@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 #include "device/tick_timer.h"
@@ -90,25 +89,12 @@ class RigidOmni final : public HapticDevice {
 }  // namespace
 
 std::unique_ptr<HapticDevice> fake_hd_make_device(const std::string& config) {
-  bool docked = false;
-  std::uint32_t buttons = 0;
-  std::stringstream in(config);
-  std::string t;
-  while (std::getline(in, t, ',')) {
-    if (t.empty()) {
-      continue;
-    } else if (t == "docked") {
-      docked = true;
-    } else if (t == "button1") {
-      buttons |= kButton1;
-    } else if (t == "button2") {
-      buttons |= kButton2;
-    } else {
-      throw std::invalid_argument("fake libHD: unknown configuration token \"" +
-                                  t + "\"");
-    }
+  const ModelTokens m = parse_model_tokens(config);
+  if (m.tour) {
+    throw std::invalid_argument(
+        "fake libHD: \"tour\" needs the emulator (a build with MuJoCo)");
   }
-  return std::make_unique<RigidOmni>(docked, buttons);
+  return std::make_unique<RigidOmni>(m.docked, m.buttons);
 }
 
 bool fake_hd_true_q_dh(const HapticDevice&, Joints*) { return false; }

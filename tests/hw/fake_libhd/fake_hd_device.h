@@ -3,6 +3,7 @@
 #ifndef VMHAPTICS_TESTS_HW_FAKE_LIBHD_FAKE_HD_DEVICE_H_
 #define VMHAPTICS_TESTS_HW_FAKE_LIBHD_FAKE_HD_DEVICE_H_
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -22,6 +23,16 @@ namespace vmh::fake_hd {
 // token for the scripted hand) when the testbed is built, and a small rigid
 // model (fake_hd_device.cc) in a build without MuJoCo.
 std::unique_ptr<HapticDevice> fake_hd_make_device(const std::string& config);
+
+// The configuration tokens the device model takes: "docked", "button1",
+// "button2" force the switches; "tour" has the emulator's scripted hand move
+// the stylus. Throws std::invalid_argument naming an unknown token.
+struct ModelTokens {
+  bool docked = false;
+  std::uint32_t buttons = 0;
+  bool tour = false;
+};
+ModelTokens parse_model_tokens(const std::string& config);
 
 // The model's own joint angles, DH convention (rad), independent of the
 // sensor path: the emulator's MuJoCo state. false for a model that has none.

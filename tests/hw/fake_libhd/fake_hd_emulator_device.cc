@@ -4,9 +4,6 @@
 // unless the configuration has the "tour" token (then the scripted hand
 // moves it through the workspace); "docked", "button1" and "button2" force
 // the switches the emulator would otherwise report.
-#include <sstream>
-#include <stdexcept>
-
 #include "sim/emulator.h"
 #include "tests/hw/fake_libhd/fake_hd_device.h"
 
@@ -49,28 +46,10 @@ class EmulatedOmni final : public HapticDevice {
 }  // namespace
 
 std::unique_ptr<HapticDevice> fake_hd_make_device(const std::string& config) {
-  bool docked = false;
-  std::uint32_t buttons = 0;
-  sim::HandProgram hand = sim::HandProgram::kNone;
-  std::stringstream in(config);
-  std::string t;
-  while (std::getline(in, t, ',')) {
-    if (t.empty()) {
-      continue;
-    } else if (t == "docked") {
-      docked = true;
-    } else if (t == "button1") {
-      buttons |= kButton1;
-    } else if (t == "button2") {
-      buttons |= kButton2;
-    } else if (t == "tour") {
-      hand = sim::HandProgram::kTour;
-    } else {
-      throw std::invalid_argument("fake libHD: unknown configuration token \"" +
-                                  t + "\"");
-    }
-  }
-  return std::make_unique<EmulatedOmni>(hand, docked, buttons);
+  const ModelTokens m = parse_model_tokens(config);
+  return std::make_unique<EmulatedOmni>(
+      m.tour ? sim::HandProgram::kTour : sim::HandProgram::kNone, m.docked,
+      m.buttons);
 }
 
 bool fake_hd_true_q_dh(const HapticDevice& device, Joints* q_dh_rad) {
