@@ -37,12 +37,19 @@ Mat3 turn_to_axis(const Mat3& R_ref, const Vec3& axis_base) {
   return q.toRotationMatrix() * R_ref;
 }
 
+ModelPtr load_hooked(const std::string& path, const ModelHook& hook) {
+  ModelPtr m = load_model(path);
+  if (hook) hook(m.get());
+  return m;
+}
+
 }  // namespace
 
 ClosedLoop::ClosedLoop(const std::string& scene_path,
-                       const std::vector<std::string>& overrides)
+                       const std::vector<std::string>& overrides,
+                       const ModelHook& model_hook)
     : path_(scene_path),
-      model_(load_model(scene_path)),
+      model_(load_hooked(scene_path, model_hook)),
       config_(CaseConfig::from_model(model_.get(), scene_path, overrides)) {
   apply_model_options();
   setup_timing();

@@ -42,6 +42,7 @@
 #include "sim/case_config.h"
 #include "device/reading_guard.h"
 #include "sim/fault_injector.h"
+#include "sim/omni_model_edit.h"
 #include "sim/hand.h"
 #include "sim/hand_script.h"
 #include "sim/mujoco_util.h"
@@ -93,8 +94,12 @@ class ClosedLoop {
   // Loads the scene, reads its parameters (with `overrides`), builds the
   // hand, device, controller and script, and puts the Omni at the script's
   // start pose. Throws SimError naming the file and field on bad input.
+  // `model_hook` (when set) changes the model right after it is loaded,
+  // before anything reads it: `--model FILE` and the emulator's seeded
+  // parameter faults (sim/omni_model_edit.h).
   ClosedLoop(const std::string& scene_path,
-             const std::vector<std::string>& overrides);
+             const std::vector<std::string>& overrides,
+             const ModelHook& model_hook = {});
   ~ClosedLoop();
   ClosedLoop(const ClosedLoop&) = delete;
   ClosedLoop& operator=(const ClosedLoop&) = delete;

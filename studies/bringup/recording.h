@@ -1,0 +1,79 @@
+// A recording as `vmhaptics hw record | motor-test | run | calibrate`
+// writes it (docs/outputs.md, "hw"): DIR/meta.json and DIR/trace.csv, read
+// back for compare and identification.
+//
+// Columns keep their names from the trace (units in the names); numbers
+// are parsed to double (an empty cell or "nan" is NaN), the text columns
+// (read_error, write_error, safety_flags) are kept as text. Frames as the
+// trace has them: q*_rad DH joint angles (q3 relative), p_*_mm / a_* the
+// project's FK in the device frame, dev_* the device's own (device frame,
+// mm; dev_J_rc row r column c as DeviceState::jacobian held them).
+#ifndef VMHAPTICS_STUDIES_BRINGUP_RECORDING_H_
+#define VMHAPTICS_STUDIES_BRINGUP_RECORDING_H_
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "controller/types.h"
+
+namespace vmh::bringup {
+
+// A recording that cannot be read: the message names the file and what
+// was wrong with it (a missing column, a short row, a bad number).
+class RecordingError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Recording {
+  std::string dir;
+  nlohmann::ordered_json meta;  // meta.json as written
+  std::string verb;             // meta["verb"]: "hw record", "hw run", ...
+  std::vector<std::string> columns;
+  std::map<std::string, std::vector<double>> num;
+  std::map<std::string, std::vector<std::string>> text;
+  std::size_t rows = 0;
+
+  bool has(const std::string& column) const;
+  // throws RecordingError naming the column and the trace
+  const std::vector<double>& col(const std::string& column) const;
+  const std::vector<std::string>& text_col(const std::string& column) const;
+
+  // rows with a good reading: read_error "ok" and finite joint angles
+  std::vector<std::size_t> good_rows() const;
+
+  // the device reports its own kinematics (dev_p_*, dev_R_*), its
+  // velocity (dev_v_*), its Jacobian (dev_J_*)
+  bool has_transform() const { return has("dev_p_x_mm"); }
+  bool has_velocity() const { return has("dev_v_x_mm_s"); }
+  bool has_jacobian() const { return has("dev_J_11"); }
+  // the emulator's ground truth is in the trace (tau_applied_*, hand_*)
+  bool has_truth() const { return has("tau_applied_1_Nm"); }
+
+  double t_s(std::size_t row) const { return col("t_s")[row]; }
+  Joints q_dh_rad(std::size_t row) const;   // q1..q6, DH (q3 relative)
+  Vec3 p_mm(std::size_t row) const;          // project FK, device frame
+  Vec3 tau_cmd_Nm(std::size_t row) const;    // tau_1..3_Nm
+  Vec3 tau_sent_Nm(std::size_t row) const;   // tau_sent_1..3_Nm
+  Vec3 dev_p_mm(std::size_t row) const;
+  Mat3 dev_R(std::size_t row) const;
+  Vec3 dev_v_mm_s(std::size_t row) const;
+  Eigen::Matrix<double, 6, 6> dev_J(std::size_t row) const;
+  // three columns prefix1suffix, prefix2suffix, prefix3suffix (or x/y/z)
+  Vec3 vec3(const std::string& prefix, const std::string& suffix,
+            std::size_t row, bool xyz = false) const;
+};
+
+// Reads DIR/meta.json and DIR/trace.csv. Throws RecordingError naming the
+// file and the problem.
+Recording load_recording(const std::string& dir);
+
+}  // namespace vmh::bringup
+
+#endif  // VMHAPTICS_STUDIES_BRINGUP_RECORDING_H_
