@@ -4,7 +4,8 @@
 // Verbs: kin (kinematics of the Omni), ctl (one controller tick), run
 // (closed-loop simulation of the thesis cases), study (numerical studies),
 // params (the table of case parameters, docs/parameters.md), hw (a device,
-// real or emulated: docs/hardware.md).
+// real or emulated: docs/hardware.md), compare (device recordings against
+// the project's kinematics and the MJCF Omni: docs/bringup.md).
 //
 // Exit codes: 0 success, 2 bad usage or bad input (a device that cannot be
 // opened included), 1 any other failure, 128 + n when signal n (SIGINT,
@@ -14,6 +15,7 @@
 #include <iostream>
 
 #include "cli/args.h"
+#include "cli/compare.h"
 #include "cli/ctl.h"
 #include "cli/hw.h"
 #include "cli/hw_common.h"
@@ -66,6 +68,7 @@ int main(int argc, char** argv) {
   vmh::cli::register_study(&app);
   vmh::cli::register_params(&app);
   vmh::cli::register_hw(&app);
+  vmh::cli::register_compare(&app);
 
   try {
     check_verbs(&app, argc, argv);
