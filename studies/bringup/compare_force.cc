@@ -4,8 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
-#include <utility>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "controller/device_frame.h"
@@ -34,11 +34,11 @@ struct PulseWindow {
   int motor = 0;           // 1..3
   double t_start_s = 0.0;  // the pulse's first row
   double pulse_s = 0.0;
-  double t_end_s = 0.0;    // the last row compared
+  double t_end_s = 0.0;       // the last row compared
   std::size_t sim_start = 0;  // index into the vectors below
   std::vector<double> t_s;
   std::vector<Vec3> tau_Nm;
-  std::vector<Joints> q;   // true device angles (NaN when not good)
+  std::vector<Joints> q;  // true device angles (NaN when not good)
   std::vector<bool> good;
 };
 
@@ -55,9 +55,11 @@ int pulsed_motor(const Recording& rec) {
   int best = 0;
   std::size_t most = 0;
   for (int m = 1; m <= 3; ++m) {
-    const std::vector<double>& c = rec.col("tau_sent_" + std::to_string(m) + "_Nm");
-    const auto n = static_cast<std::size_t>(std::count_if(
-        c.begin(), c.end(), [](double v) { return std::isfinite(v) && v != 0.0; }));
+    const std::vector<double>& c =
+        rec.col("tau_sent_" + std::to_string(m) + "_Nm");
+    const auto n = static_cast<std::size_t>(
+        std::count_if(c.begin(), c.end(),
+                      [](double v) { return std::isfinite(v) && v != 0.0; }));
     if (n > most) most = n, best = m;
   }
   return best;
@@ -74,23 +76,27 @@ std::string find_pulse(const Recording& rec, const ReadingMap& map,
       rec.col("tau_sent_" + std::to_string(w->motor) + "_Nm");
   std::size_t start = rec.rows, last = rec.rows;
   for (std::size_t r = 0; r < rec.rows; ++r) {
-    if (!std::isfinite(ts[r]) || !std::isfinite(tau[r]) || tau[r] == 0.0) continue;
+    if (!std::isfinite(ts[r]) || !std::isfinite(tau[r]) || tau[r] == 0.0)
+      continue;
     if (start == rec.rows) start = r;
     last = r;
   }
   if (start == rec.rows) {
-    return "motor " + std::to_string(w->motor) + " never had a torque sent (no pulse)";
+    return "motor " + std::to_string(w->motor) +
+           " never had a torque sent (no pulse)";
   }
   w->t_start_s = ts[start];
-  const double period_s = start + 1 < rec.rows ? ts[start + 1] - ts[start] : 1e-3;
+  const double period_s =
+      start + 1 < rec.rows ? ts[start + 1] - ts[start] : 1e-3;
   w->pulse_s = ts[last] - ts[start] + std::max(period_s, 0.0);
-  w->t_end_s = w->t_start_s +
-               std::min(w->pulse_s + 1e-3 * o.settle_ms, 1e-3 * o.max_window_ms);
+  w->t_end_s = w->t_start_s + std::min(w->pulse_s + 1e-3 * o.settle_ms,
+                                       1e-3 * o.max_window_ms);
   const double t_first = w->t_start_s - 1e-3 * o.pre_ms;
   std::vector<bool> good(rec.rows, false);
   for (std::size_t r : rec.good_rows()) good[r] = true;
   for (std::size_t r = 0; r < rec.rows; ++r) {
-    if (!std::isfinite(ts[r]) || ts[r] < t_first || ts[r] > w->t_end_s) continue;
+    if (!std::isfinite(ts[r]) || ts[r] < t_first || ts[r] > w->t_end_s)
+      continue;
     if (!w->t_s.empty() && ts[r] <= w->t_s.back()) continue;  // not increasing
     w->t_s.push_back(ts[r]);
     Vec3 t = rec.tau_sent_Nm(r);
@@ -99,8 +105,9 @@ std::string find_pulse(const Recording& rec, const ReadingMap& map,
     }
     w->tau_Nm.push_back(t);
     w->good.push_back(good[r]);
-    w->q.push_back(good[r] ? map.true_from_reported(dh_to_device_joints(rec.q_dh_rad(r)))
-                           : Joints::Constant(kNan));
+    w->q.push_back(
+        good[r] ? map.true_from_reported(dh_to_device_joints(rec.q_dh_rad(r)))
+                : Joints::Constant(kNan));
   }
   // the simulation starts half-way through the quiet samples before the pulse
   const double t_sim = w->t_start_s - 0.5e-3 * o.pre_ms;
@@ -124,7 +131,8 @@ ResponseInput response_input(const PulseWindow& w, const ForceOptions& o) {
   ResponseInput in;
   const std::size_t k = w.sim_start;
   in.t_s.assign(w.t_s.begin() + static_cast<long>(k), w.t_s.end());
-  in.tau_motor_Nm.assign(w.tau_Nm.begin() + static_cast<long>(k), w.tau_Nm.end());
+  in.tau_motor_Nm.assign(w.tau_Nm.begin() + static_cast<long>(k),
+                         w.tau_Nm.end());
   in.q0_device_rad = w.q[k];
   // the velocity from the quiet samples only: the pulse must not bend it
   std::vector<double> t;
@@ -193,11 +201,15 @@ constexpr double kWindowEffect_rad = 10.0 * 2.0 * kPi / 15000.0;
 // the end of the angle and gain's window: t1_s, or later (up to the
 // window's end) until the predicted effect reaches kWindowEffect_rad
 double response_window_end(const PulseWindow& w, const SimulatedResponse& pred,
-                           const SimulatedResponse& free, double t0_s, double t1_s) {
+                           const SimulatedResponse& free, double t0_s,
+                           double t1_s) {
   for (std::size_t j = 0; j < pred.t_s.size(); ++j) {
     const double t = pred.t_s[j];
     if (t < t0_s) continue;
-    const double e = (pred.q_device_rad[j] - free.q_device_rad[j]).head<3>().cwiseAbs().maxCoeff();
+    const double e = (pred.q_device_rad[j] - free.q_device_rad[j])
+                         .head<3>()
+                         .cwiseAbs()
+                         .maxCoeff();
     if (t >= t1_s && e >= kWindowEffect_rad) return t;
   }
   return w.t_end_s;
@@ -220,7 +232,8 @@ Fit fit(const std::vector<double>& m, const std::vector<double>& p) {
   if (p.empty() || peak < kMinEffect_rad) return f;
   f.gain = mp / pp;
   if (mm > 0.0) {
-    f.angle_deg = std::acos(std::clamp(mp / std::sqrt(mm * pp), -1.0, 1.0)) * 180.0 / kPi;
+    f.angle_deg =
+        std::acos(std::clamp(mp / std::sqrt(mm * pp), -1.0, 1.0)) * 180.0 / kPi;
   }
   return f;
 }
@@ -248,8 +261,9 @@ void write_figure(const PulseWindow& w, const SimulatedResponse& nominal,
   report::ChartGrid g;
   g.title = "force direction: motor " + std::to_string(w.motor) + " pulse, " +
             fmt(1e3 * w.pulse_s) + " ms";
-  g.notes.push_back("device joints t1..t3 (rad), measured through the reading map; "
-                    "time from the pulse's start (ms)");
+  g.notes.push_back(
+      "device joints t1..t3 (rad), measured through the reading map; "
+      "time from the pulse's start (ms)");
   g.columns = 3;
   for (int c = 0; c < 3; ++c) {
     report::Chart ch;
@@ -258,8 +272,10 @@ void write_figure(const PulseWindow& w, const SimulatedResponse& nominal,
     ch.y.label = "t" + std::to_string(c + 1) + " (rad)";
     ch.bands.push_back({0.0, 1e3 * w.pulse_s, "#e8e8e8"});
     report::ChartSeries meas{"measured", {}, {}, "#1f77b4", false, true, false};
-    report::ChartSeries pred{"predicted", {}, {}, "#d62728", true, false, false};
-    report::ChartSeries hyp{named ? named->name : "", {}, {}, "#2ca02c", true, false, true};
+    report::ChartSeries pred{"predicted", {},    {},   "#d62728",
+                             true,        false, false};
+    report::ChartSeries hyp{
+        named ? named->name : "", {}, {}, "#2ca02c", true, false, true};
     for (std::size_t j = 0; j < nominal.t_s.size(); ++j) {
       const std::size_t i = w.sim_start + j;
       const double t_ms = 1e3 * (w.t_s[i] - w.t_start_s);
@@ -300,16 +316,19 @@ void ForceOptions::validate() const {
   positive(lag_excess_ms, "lag_excess_ms");
   positive(hypothesis_ratio, "hypothesis_ratio");
   if (!(settle_ms >= 0.0) || !std::isfinite(settle_ms)) {
-    throw std::invalid_argument("ForceOptions.settle_ms must be a finite number >= 0");
+    throw std::invalid_argument(
+        "ForceOptions.settle_ms must be a finite number >= 0");
   }
   if (!(gain_max > gain_min) || !std::isfinite(gain_max)) {
-    throw std::invalid_argument("ForceOptions.gain_max must be finite and > gain_min");
+    throw std::invalid_argument(
+        "ForceOptions.gain_max must be finite and > gain_min");
   }
   if (!(lag_max_ms >= 1.0) || lag_max_ms > 200.0) {
     throw std::invalid_argument("ForceOptions.lag_max_ms must be in [1, 200]");
   }
   if (!(lag_baseline_ms >= 0.0) || lag_baseline_ms > lag_max_ms) {
-    throw std::invalid_argument("ForceOptions.lag_baseline_ms must be in [0, lag_max_ms]");
+    throw std::invalid_argument(
+        "ForceOptions.lag_baseline_ms must be in [0, lag_max_ms]");
   }
 }
 
@@ -330,8 +349,8 @@ CompareSection compare_force_direction(const Recording& rec,
     return s;
   }
   const std::string prefix = "force_direction.motor" + std::to_string(w.motor);
-  std::string scene = o.scene.empty() ? studies::models_dir() + "/cases/case1.xml"
-                                      : o.scene;
+  std::string scene =
+      o.scene.empty() ? studies::models_dir() + "/cases/case1.xml" : o.scene;
   // the emulator's own scene when it says which (never its seeded faults)
   if (rec.meta.contains("emulator") && rec.meta["emulator"].is_object() &&
       rec.meta["emulator"].contains("scene") &&
@@ -360,7 +379,10 @@ CompareSection compare_force_direction(const Recording& rec,
       const double mp = dot(m, p);
       res = dot(m, m) - mp * mp / pp;
     }
-    lag_curve.push_back({{"lag_ms", d}, {"residual_rad2", std::isfinite(res) ? nlohmann::ordered_json(res) : nlohmann::ordered_json()}});
+    lag_curve.push_back(
+        {{"lag_ms", d},
+         {"residual_rad2", std::isfinite(res) ? nlohmann::ordered_json(res)
+                                              : nlohmann::ordered_json()}});
     if (std::isfinite(res) && res < best_res) best_res = res, best_lag = d;
   }
   const double lag_ms = best_lag >= 0 ? static_cast<double>(best_lag) : kNan;
@@ -369,44 +391,51 @@ CompareSection compare_force_direction(const Recording& rec,
   // prediction has moved kWindowEffect_rad: a few counts' quantization
   // would otherwise decide the angle
   const double t0_fit_s = w.t_start_s + 1e-3 * static_cast<double>(at);
-  const double t1_fit_s =
-      response_window_end(w, by_lag[at], free, t0_fit_s, t0_fit_s + 1e-3 * o.initial_ms);
+  const double t1_fit_s = response_window_end(w, by_lag[at], free, t0_fit_s,
+                                              t0_fit_s + 1e-3 * o.initial_ms);
   effects(w, by_lag[at], free, t0_fit_s, t1_fit_s, &m, &p);
   const Fit nominal_fit = fit(m, p);
 
   const std::string at_lag = " at the fitted lag " + fmt(lag_ms) + " ms";
-  s.checks.push_back(make_check(
-      prefix + "_angle", nominal_fit.angle_deg, o.angle_max_deg, "deg",
-      CompareCheck::kAtMost,
-      "angle between measured and predicted t1..t3 motion over the response's first " +
-          fmt(1e3 * (t1_fit_s - t0_fit_s)) + " ms" + at_lag));
-  const CompareCheck gain_lo = make_check(prefix + "_gain", nominal_fit.gain, o.gain_min,
-                                          "ratio", CompareCheck::kAtLeast);
+  s.checks.push_back(make_check(prefix + "_angle", nominal_fit.angle_deg,
+                                o.angle_max_deg, "deg", CompareCheck::kAtMost,
+                                "angle between measured and predicted t1..t3 "
+                                "motion over the response's first " +
+                                    fmt(1e3 * (t1_fit_s - t0_fit_s)) + " ms" +
+                                    at_lag));
+  const CompareCheck gain_lo =
+      make_check(prefix + "_gain", nominal_fit.gain, o.gain_min, "ratio",
+                 CompareCheck::kAtLeast);
   CompareCheck gain = make_check(
-      prefix + "_gain", nominal_fit.gain, o.gain_max, "ratio", CompareCheck::kAtMost,
-      "least-squares measured/predicted amplitude" + at_lag + ", pass within [" +
-          fmt(o.gain_min) + ", " + fmt(o.gain_max) + "]");
+      prefix + "_gain", nominal_fit.gain, o.gain_max, "ratio",
+      CompareCheck::kAtMost,
+      "least-squares measured/predicted amplitude" + at_lag +
+          ", pass within [" + fmt(o.gain_min) + ", " + fmt(o.gain_max) + "]");
   gain.pass = gain.pass && gain_lo.pass;
   s.checks.push_back(gain);
-  s.checks.push_back(make_check(
-      prefix + "_lag", lag_ms, o.lag_baseline_ms + o.lag_excess_ms, "ms",
-      CompareCheck::kAtMost,
-      "extra delay (0.." + fmt(o.lag_max_ms) + " ms) that best fits; a clean recording shows " +
-          fmt(o.lag_baseline_ms) + " ms"));
+  s.checks.push_back(
+      make_check(prefix + "_lag", lag_ms, o.lag_baseline_ms + o.lag_excess_ms,
+                 "ms", CompareCheck::kAtMost,
+                 "extra delay (0.." + fmt(o.lag_max_ms) +
+                     " ms) that best fits; a clean recording shows " +
+                     fmt(o.lag_baseline_ms) + " ms"));
   for (CompareCheck& c : s.checks) c.recording = rec.dir;
 
   // the nominal prediction: a clean device's lag
-  const std::size_t base = static_cast<std::size_t>(std::lround(o.lag_baseline_ms));
+  const std::size_t base =
+      static_cast<std::size_t>(std::lround(o.lag_baseline_ms));
   const SimulatedResponse& nominal = by_lag[std::min(base, by_lag.size() - 1)];
   const double rms0 = rms_error(w, nominal);
-  const bool failed = std::any_of(s.checks.begin(), s.checks.end(),
-                                  [](const CompareCheck& c) { return !c.pass; });
+  const bool failed =
+      std::any_of(s.checks.begin(), s.checks.end(),
+                  [](const CompareCheck& c) { return !c.pass; });
   nlohmann::ordered_json hyp_json = nlohmann::ordered_json::array();
   const Hypothesis* named = nullptr;
   std::vector<Hypothesis> hyps;
   if (failed) {
     const double base_s = 1e-3 * static_cast<double>(base);
-    Hypothesis sign = hypothesis("motor" + std::to_string(w.motor) + "_sign", base_s);
+    Hypothesis sign =
+        hypothesis("motor" + std::to_string(w.motor) + "_sign", base_s);
     sign.edit.motor_gain[w.motor - 1] = -1.0;
     hyps.push_back(sign);
     if (w.motor == 3) {
@@ -418,8 +447,9 @@ CompareSection compare_force_direction(const Recording& rec,
     hyps.push_back(hypothesis("torque_units_mNm", base_s, 0.001));
     const double excess_ms = lag_ms - o.lag_baseline_ms;
     if (excess_ms >= o.lag_excess_ms) {
-      hyps.push_back(hypothesis("delay_" + std::to_string(std::lround(excess_ms)) + "ms",
-                                1e-3 * lag_ms));
+      hyps.push_back(
+          hypothesis("delay_" + std::to_string(std::lround(excess_ms)) + "ms",
+                     1e-3 * lag_ms));
     }
     for (Hypothesis& h : hyps) {
       h.response = h.scale == 1.0 && h.edit.is_identity()
@@ -432,7 +462,8 @@ CompareSection compare_force_direction(const Recording& rec,
       }
       hyp_json.push_back({{"name", h.name}, {"rms_rad", h.rms_rad}});
     }
-    if (named != nullptr && !(named->rms_rad < o.hypothesis_ratio * rms0)) named = nullptr;
+    if (named != nullptr && !(named->rms_rad < o.hypothesis_ratio * rms0))
+      named = nullptr;
     std::string fault, evidence;
     if (named != nullptr) {
       fault = named->name;
@@ -447,7 +478,8 @@ CompareSection compare_force_direction(const Recording& rec,
     } else if (!s.checks[0].pass) {
       fault = "motor" + std::to_string(w.motor) + "_direction";
     } else {
-      fault = "delay_" + std::to_string(std::lround(lag_ms - o.lag_baseline_ms)) + "ms";
+      fault = "delay_" +
+              std::to_string(std::lround(lag_ms - o.lag_baseline_ms)) + "ms";
     }
     if (evidence.empty()) {
       evidence = "angle " + fmt(nominal_fit.angle_deg) + " deg, gain " +
@@ -464,7 +496,8 @@ CompareSection compare_force_direction(const Recording& rec,
     nlohmann::ordered_json qm = nullptr;
     if (w.good[i]) qm = {w.q[i][0], w.q[i][1], w.q[i][2]};
     row["measured_rad"] = qm;
-    row["predicted_rad"] = {nominal.q_device_rad[j][0], nominal.q_device_rad[j][1],
+    row["predicted_rad"] = {nominal.q_device_rad[j][0],
+                            nominal.q_device_rad[j][1],
                             nominal.q_device_rad[j][2]};
     hist.push_back(row);
   }
@@ -475,7 +508,8 @@ CompareSection compare_force_direction(const Recording& rec,
               {"pulse_ms", 1e3 * w.pulse_s},
               {"window_end_s", w.t_end_s},
               {"initial_velocity_rad_s",
-               {in.qdot0_device_rad_s[0], in.qdot0_device_rad_s[1], in.qdot0_device_rad_s[2]}},
+               {in.qdot0_device_rad_s[0], in.qdot0_device_rad_s[1],
+                in.qdot0_device_rad_s[2]}},
               {"joint_space", "device t1..t3 (rad)"},
               {"nominal_rms_rad", rms0},
               {"lag_search", lag_curve},
@@ -490,22 +524,26 @@ CompareSection compare_force_mapping(const Recording& run) {
   s.name = "force_mapping";
   const std::string name = "force_mapping.torque_angle_p95";
   if (!run.has("F_x_N") || !run.has("tau_1_Nm")) {
-    s.skipped.push_back({name, "the trace has no F_*_N (not a hw run)", run.dir});
+    s.skipped.push_back(
+        {name, "the trace has no F_*_N (not a hw run)", run.dir});
     return s;
   }
   if (!run.has_jacobian()) {
-    s.skipped.push_back({name, "the device reports no Jacobian (dev_J_*)", run.dir});
+    s.skipped.push_back(
+        {name, "the device reports no Jacobian (dev_J_*)", run.dir});
     return s;
   }
   // four readings of the device's Jacobian: as stored or transposed, its
   // columns device joints t1..t3 or DH joints q1..q3
-  const char* kReading[4] = {"stored, device joints", "transposed, device joints",
-                             "stored, DH joints", "transposed, DH joints"};
+  const char* kReading[4] = {"stored, device joints",
+                             "transposed, device joints", "stored, DH joints",
+                             "transposed, DH joints"};
   std::vector<double> angles[4];
   for (std::size_t r : run.good_rows()) {
     const Vec3 F = run.vec3("F_", "_N", r, true);
     const Vec3 tau = run.tau_cmd_Nm(r);
-    if (!F.allFinite() || F.norm() <= 0.1 || !tau.allFinite() || tau.norm() < 1e-9) {
+    if (!F.allFinite() || F.norm() <= 0.1 || !tau.allFinite() ||
+        tau.norm() < 1e-9) {
       continue;
     }
     const Eigen::Matrix<double, 6, 6> J = run.dev_J(r);
@@ -516,20 +554,23 @@ CompareSection compare_force_mapping(const Recording& run) {
       Vec3 t = 1e-3 * Jl.transpose() * F;  // mm/rad to m/rad: N m
       if (k >= 2) t = dh_to_motor_torques(t);
       const double c = t.dot(tau) / (t.norm() * tau.norm());
-      angles[k].push_back(std::isfinite(c)
-                              ? std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi
-                              : 180.0);
+      angles[k].push_back(
+          std::isfinite(c) ? std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi
+                           : 180.0);
     }
   }
   if (angles[0].empty()) {
-    s.skipped.push_back({name, "no good row with |F| > 0.1 N and a torque sent", run.dir});
+    s.skipped.push_back(
+        {name, "no good row with |F| > 0.1 N and a torque sent", run.dir});
     return s;
   }
   double p95[4];
   int best = 0;
   for (int k = 0; k < 4; ++k) {
     std::vector<double> a = angles[k];
-    const std::size_t n = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(a.size()))) - 1;
+    const std::size_t n = static_cast<std::size_t>(
+                              std::ceil(0.95 * static_cast<double>(a.size()))) -
+                          1;
     std::nth_element(a.begin(), a.begin() + static_cast<long>(n), a.end());
     p95[k] = a[n];
     if (p95[k] < p95[best]) best = k;
@@ -537,17 +578,19 @@ CompareSection compare_force_mapping(const Recording& run) {
   CompareCheck c = make_check(
       name, p95[best], 10.0, "deg", CompareCheck::kAtMost,
       "angle between tau_1..3_Nm (J_r^T F) and J_dev^T F, J_dev read " +
-          std::string(kReading[best]) + ", over " + std::to_string(angles[0].size()) +
-          " rows with |F| > 0.1 N");
+          std::string(kReading[best]) + ", over " +
+          std::to_string(angles[0].size()) + " rows with |F| > 0.1 N");
   c.recording = run.dir;
   s.checks.push_back(c);
   nlohmann::ordered_json readings = nlohmann::ordered_json::object();
   for (int k = 0; k < 4; ++k) readings[kReading[k]] = p95[k];
-  s.detail = {{"rows", static_cast<long>(angles[0].size())}, {"best_reading", kReading[best]},
+  s.detail = {{"rows", static_cast<long>(angles[0].size())},
+              {"best_reading", kReading[best]},
               {"p95_deg_by_reading", readings}};
   if (!c.pass) {
-    s.faults.push_back({"force_mapping", "p95 angle " + fmt(p95[best]) +
-                        " deg between the project's and the device's J^T F",
+    s.faults.push_back({"force_mapping",
+                        "p95 angle " + fmt(p95[best]) +
+                            " deg between the project's and the device's J^T F",
                         run.dir});
   }
   return s;

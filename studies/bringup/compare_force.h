@@ -24,8 +24,10 @@
 //     emulator applies a command one servo period after it is written), a
 //     real device a few; 3 ms more is beyond jitter at 1 kHz.
 //   - force_direction.motor<N>_angle (deg, at most angle_max_deg = 25):
-//     the angle between the measured and predicted effects over the first
-//     initial_ms of the pulse, stacked sample by sample, at the fitted lag.
+//     the angle between the measured and predicted effects, stacked sample
+//     by sample, over the response's first initial_ms from the fitted lag
+//     (longer, up to the window's end, until the prediction has moved ten
+//     encoder counts: a few counts' quantization would decide the angle).
 //     A sign error gives ~180 deg and motor 3 on the relative angle tens of
 //     degrees; encoder quantization and a model off by tens of percent in
 //     its masses give a few.
@@ -42,6 +44,10 @@
 //   none clearly better: gain > 10 names torque_units_Nm, gain < 0.1
 //   torque_units_mNm, another gain outside the band motor<N>_gain, an
 //   angle alone motor<N>_direction.
+//   Measured on recordings synthesized from the closed loop (15000-count
+//   encoders, 120-200 mN m pulses of 40 ms): clean 1.7-4.6 deg, gain
+//   0.97-1.00, lag 0-1 ms; a reversed motor 172-177 deg; motor 3 on q3
+//   68 deg and gain 3.6; readings 5 ms late a lag of 6 ms.
 //   No pulse (not a motor test, or tau_sent never nonzero): every check is
 //   skipped with the reason.
 //   Figure force_direction_motor<N>.svg: t1..t3 measured and predicted
@@ -72,11 +78,11 @@ struct ForceOptions {
   // (meta["emulator"]["scene"]); empty: models/cases/case1.xml, the
   // emulator's default
   std::string scene;
-  std::string model_file;  // a calibrated Omni (--model); empty: none
-  double pre_ms = 20.0;      // before the pulse, for the initial velocity
-  double settle_ms = 50.0;   // after the pulse, still compared
+  std::string model_file;        // a calibrated Omni (--model); empty: none
+  double pre_ms = 20.0;          // before the pulse, for the initial velocity
+  double settle_ms = 50.0;       // after the pulse, still compared
   double max_window_ms = 300.0;  // pulse + settle at most this
-  double initial_ms = 25.0;  // the pulse's start, for angle and gain
+  double initial_ms = 25.0;      // the response's start: angle and gain
   double angle_max_deg = 25.0;
   double gain_min = 0.5;
   double gain_max = 2.0;

@@ -20,12 +20,14 @@ std::string fmt(double v, int precision = 4) {
   return s.str();
 }
 
-bool text_is(const Recording& r, const char* column, std::size_t row, const char* want) {
+bool text_is(const Recording& r, const char* column, std::size_t row,
+             const char* want) {
   return !r.has(column) || r.text_col(column)[row] == want;
 }
 
 // the gain scale hw run applied, as the header says where it is found
-double gain_scale_of(const Recording& r, const ReplayOptions& o, std::string* source) {
+double gain_scale_of(const Recording& r, const ReplayOptions& o,
+                     std::string* source) {
   if (std::isfinite(o.gain_scale)) {
     *source = "option";
     return o.gain_scale;
@@ -50,7 +52,8 @@ double gain_scale_of(const Recording& r, const ReplayOptions& o, std::string* so
   return 1.0;
 }
 
-std::vector<std::string> overrides_of(const Recording& r, const ReplayOptions& o) {
+std::vector<std::string> overrides_of(const Recording& r,
+                                      const ReplayOptions& o) {
   std::vector<std::string> out;
   if (r.meta.contains("sets") && r.meta["sets"].is_array()) {
     for (const auto& s : r.meta["sets"]) {
@@ -73,15 +76,17 @@ struct Series {
   double rms(const std::vector<double>& v) const {
     double s = 0.0;
     for (double x : v) s += x * x;
-    return v.empty() ? std::nan("") : std::sqrt(s / static_cast<double>(v.size()));
+    return v.empty() ? std::nan("")
+                     : std::sqrt(s / static_cast<double>(v.size()));
   }
 };
 
-CompareCheck ratio_check(const std::string& name, double value, const ReplayOptions& o,
-                         const std::string& detail) {
-  CompareCheck c = make_check(name, value, o.ratio_max, "ratio", CompareCheck::kAtMost,
-                              detail + "; pass within [" + fmt(o.ratio_min) + ", " +
-                                  fmt(o.ratio_max) + "]");
+CompareCheck ratio_check(const std::string& name, double value,
+                         const ReplayOptions& o, const std::string& detail) {
+  CompareCheck c =
+      make_check(name, value, o.ratio_max, "ratio", CompareCheck::kAtMost,
+                 detail + "; pass within [" + fmt(o.ratio_min) + ", " +
+                     fmt(o.ratio_max) + "]");
   c.pass = c.pass && value >= o.ratio_min;
   return c;
 }
@@ -90,7 +95,9 @@ void write_figure(const Series& rec, const Series& sim, const std::string& dir,
                   CompareSection* s) {
   report::ChartGrid g;
   g.title = "closed loop: recorded against the simulated scene";
-  g.notes.push_back("a real hand is not the scene's scripted hand: compare levels, not traces");
+  g.notes.push_back(
+      "a real hand is not the scene's scripted hand: compare levels, not "
+      "traces");
   g.columns = 2;
   const char* what[2] = {"|e| position error (mm)", "|F| commanded force (N)"};
   for (int k = 0; k < 2; ++k) {
@@ -98,10 +105,10 @@ void write_figure(const Series& rec, const Series& sim, const std::string& dir,
     ch.title = what[k];
     ch.x.label = "t (s)";
     ch.y.label = what[k];
-    ch.series.push_back({"recorded", rec.t_s, k == 0 ? rec.e_mm : rec.F_N, "#1f77b4",
-                         true, false, false});
-    ch.series.push_back({"simulated", sim.t_s, k == 0 ? sim.e_mm : sim.F_N, "#d62728",
-                         true, false, true});
+    ch.series.push_back({"recorded", rec.t_s, k == 0 ? rec.e_mm : rec.F_N,
+                         "#1f77b4", true, false, false});
+    ch.series.push_back({"simulated", sim.t_s, k == 0 ? sim.e_mm : sim.F_N,
+                         "#d62728", true, false, true});
     g.panels.push_back(ch);
   }
   s->figures.push_back(
@@ -109,8 +116,8 @@ void write_figure(const Series& rec, const Series& sim, const std::string& dir,
 }
 
 // (a) the replay; fills its check and detail
-void replay(const Recording& r, const ControllerParams& params, const ReplayOptions& o,
-            CompareSection* s) {
+void replay(const Recording& r, const ControllerParams& params,
+            const ReplayOptions& o, CompareSection* s) {
   Controller c(params);
   ControlOutput out;
   double worst_Nm = 0.0;
@@ -124,7 +131,8 @@ void replay(const Recording& r, const ControllerParams& params, const ReplayOpti
       ++failed_reads;
     } else {
       const ControlStatus st = c.tick(q, &out);
-      if (!is_fault(st) && text_is(r, "write_error", i, "ok")) expect = out.tau_motor_Nm;
+      if (!is_fault(st) && text_is(r, "write_error", i, "ok"))
+        expect = out.tau_motor_Nm;
     }
     const Vec3 rec = r.tau_cmd_Nm(i);
     if (!rec.allFinite()) continue;
@@ -137,23 +145,30 @@ void replay(const Recording& r, const ControllerParams& params, const ReplayOpti
       first_rep = expect;
     }
   }
-  std::string detail = "fresh controller over " + std::to_string(compared) + " rows (" +
-                       std::to_string(failed_reads) + " failed reads)";
-  nlohmann::ordered_json d{{"rows_compared", compared}, {"failed_reads", failed_reads}};
+  std::string detail = "fresh controller over " + std::to_string(compared) +
+                       " rows (" + std::to_string(failed_reads) +
+                       " failed reads)";
+  nlohmann::ordered_json d{{"rows_compared", compared},
+                           {"failed_reads", failed_reads}};
   if (first >= 0) {
     const auto row = static_cast<std::size_t>(first);
     detail += "; first differing row " + std::to_string(first) + " (t_s " +
-              fmt(r.t_s(row), 6) + "): recorded " + fmt(1e3 * first_rec[0]) + ", " +
-              fmt(1e3 * first_rec[1]) + ", " + fmt(1e3 * first_rec[2]) +
-              " mN m, replayed " + fmt(1e3 * first_rep[0]) + ", " + fmt(1e3 * first_rep[1]) +
-              ", " + fmt(1e3 * first_rep[2]) + " mN m";
-    d["first_differing_row"] = {{"row", first},
-                                {"t_s", r.t_s(row)},
-                                {"recorded_mNm", {1e3 * first_rec[0], 1e3 * first_rec[1], 1e3 * first_rec[2]}},
-                                {"replayed_mNm", {1e3 * first_rep[0], 1e3 * first_rep[1], 1e3 * first_rep[2]}}};
+              fmt(r.t_s(row), 6) + "): recorded " + fmt(1e3 * first_rec[0]) +
+              ", " + fmt(1e3 * first_rec[1]) + ", " + fmt(1e3 * first_rec[2]) +
+              " mN m, replayed " + fmt(1e3 * first_rep[0]) + ", " +
+              fmt(1e3 * first_rep[1]) + ", " + fmt(1e3 * first_rep[2]) +
+              " mN m";
+    d["first_differing_row"] = {
+        {"row", first},
+        {"t_s", r.t_s(row)},
+        {"recorded_mNm",
+         {1e3 * first_rec[0], 1e3 * first_rec[1], 1e3 * first_rec[2]}},
+        {"replayed_mNm",
+         {1e3 * first_rep[0], 1e3 * first_rep[1], 1e3 * first_rep[2]}}};
   }
-  CompareCheck ck = make_check("closed_loop.replay_torque_error_max", 1e3 * worst_Nm,
-                               o.torque_error_max_mNm, "mNm", CompareCheck::kAtMost, detail);
+  CompareCheck ck =
+      make_check("closed_loop.replay_torque_error_max", 1e3 * worst_Nm,
+                 o.torque_error_max_mNm, "mNm", CompareCheck::kAtMost, detail);
   ck.recording = r.dir;
   s->checks.push_back(ck);
   s->detail["replay"] = d;
@@ -161,8 +176,9 @@ void replay(const Recording& r, const ControllerParams& params, const ReplayOpti
 
 // (b) the scene simulated for the recording's length; fills its checks
 void simulate(const Recording& r, const std::string& scene,
-              std::vector<std::string> overrides, double gain_scale, const ReplayOptions& o,
-              const std::string& figure_dir, CompareSection* s) {
+              std::vector<std::string> overrides, double gain_scale,
+              const ReplayOptions& o, const std::string& figure_dir,
+              CompareSection* s) {
   Series rec;
   for (std::size_t i : r.good_rows()) {
     const Vec3 e = r.vec3("e_", "_mm", i);
@@ -173,7 +189,8 @@ void simulate(const Recording& r, const std::string& scene,
     rec.F_N.push_back(F.norm());
   }
   if (rec.t_s.size() < 2) {
-    for (const char* n : {"closed_loop.error_rms_ratio", "closed_loop.force_rms_ratio"}) {
+    for (const char* n :
+         {"closed_loop.error_rms_ratio", "closed_loop.force_rms_ratio"}) {
       s->skipped.push_back({n, "fewer than two good rows with e and F", r.dir});
     }
     return;
@@ -184,9 +201,12 @@ void simulate(const Recording& r, const std::string& scene,
   {
     const sim::ClosedLoop probe(scene, overrides);
     const sim::ControllerSettings& cs = probe.config().controller;
-    overrides.push_back("k_pos_N_per_mm=" + fmt(gain_scale * cs.k_pos_N_per_mm, 17));
-    overrides.push_back("k_ornt_multiple=" + fmt(gain_scale * cs.k_ornt_multiple, 17));
-    overrides.push_back("k_vel_Ns_per_mm=" + fmt(gain_scale * cs.k_vel_Ns_per_mm, 17));
+    overrides.push_back("k_pos_N_per_mm=" +
+                        fmt(gain_scale * cs.k_pos_N_per_mm, 17));
+    overrides.push_back("k_ornt_multiple=" +
+                        fmt(gain_scale * cs.k_ornt_multiple, 17));
+    overrides.push_back("k_vel_Ns_per_mm=" +
+                        fmt(gain_scale * cs.k_vel_Ns_per_mm, 17));
     overrides.push_back("k_vel_ornt_Nmms_per_rad=" +
                         fmt(gain_scale * cs.k_vel_ornt_Nmms_per_rad, 17));
   }
@@ -206,17 +226,20 @@ void simulate(const Recording& r, const std::string& scene,
       "closed_loop.error_rms_ratio", e_ratio, o,
       "RMS |e_1..3_mm| recorded " + fmt(rec.rms(rec.e_mm)) + " mm, simulated " +
           fmt(sim.rms(sim.e_mm)) + " mm" + over));
-  s->checks.push_back(ratio_check(
-      "closed_loop.force_rms_ratio", f_ratio, o,
-      "RMS |F| recorded " + fmt(rec.rms(rec.F_N)) + " N, simulated " +
-          fmt(sim.rms(sim.F_N)) + " N" + over));
+  s->checks.push_back(ratio_check("closed_loop.force_rms_ratio", f_ratio, o,
+                                  "RMS |F| recorded " + fmt(rec.rms(rec.F_N)) +
+                                      " N, simulated " + fmt(sim.rms(sim.F_N)) +
+                                      " N" + over));
   for (std::size_t k = s->checks.size() - 2; k < s->checks.size(); ++k) {
     s->checks[k].recording = r.dir;
   }
-  s->detail["simulation"] = {{"duration_s", duration_s},
-                             {"error_rms_mm", {{"recorded", rec.rms(rec.e_mm)}, {"simulated", sim.rms(sim.e_mm)}}},
-                             {"force_rms_N", {{"recorded", rec.rms(rec.F_N)}, {"simulated", sim.rms(sim.F_N)}}},
-                             {"hand", "the scene's scripted hand; a person differs"}};
+  s->detail["simulation"] = {
+      {"duration_s", duration_s},
+      {"error_rms_mm",
+       {{"recorded", rec.rms(rec.e_mm)}, {"simulated", sim.rms(sim.e_mm)}}},
+      {"force_rms_N",
+       {{"recorded", rec.rms(rec.F_N)}, {"simulated", sim.rms(sim.F_N)}}},
+      {"hand", "the scene's scripted hand; a person differs"}};
   if (!figure_dir.empty()) write_figure(rec, sim, figure_dir, s);
 }
 
@@ -224,14 +247,19 @@ void simulate(const Recording& r, const std::string& scene,
 
 void ReplayOptions::validate() const {
   if (!(torque_error_max_mNm > 0.0) || !std::isfinite(torque_error_max_mNm)) {
-    throw std::invalid_argument("ReplayOptions.torque_error_max_mNm must be a finite number > 0");
-  }
-  if (!(ratio_min > 0.0) || !(ratio_max > ratio_min) || !std::isfinite(ratio_max)) {
     throw std::invalid_argument(
-        "ReplayOptions.ratio_min and ratio_max must satisfy 0 < ratio_min < ratio_max");
+        "ReplayOptions.torque_error_max_mNm must be a finite number > 0");
   }
-  if (!std::isnan(gain_scale) && !(gain_scale >= 0.0 && std::isfinite(gain_scale))) {
-    throw std::invalid_argument("ReplayOptions.gain_scale must be a number >= 0 (or NaN)");
+  if (!(ratio_min > 0.0) || !(ratio_max > ratio_min) ||
+      !std::isfinite(ratio_max)) {
+    throw std::invalid_argument(
+        "ReplayOptions.ratio_min and ratio_max must satisfy 0 < ratio_min < "
+        "ratio_max");
+  }
+  if (!std::isnan(gain_scale) &&
+      !(gain_scale >= 0.0 && std::isfinite(gain_scale))) {
+    throw std::invalid_argument(
+        "ReplayOptions.gain_scale must be a number >= 0 (or NaN)");
   }
 }
 
@@ -240,23 +268,29 @@ CompareSection compare_closed_loop(const Recording& r, const ReplayOptions& o,
   o.validate();
   CompareSection s;
   s.name = "closed_loop";
-  const char* kAll[3] = {"closed_loop.replay_torque_error_max", "closed_loop.error_rms_ratio",
+  const char* kAll[3] = {"closed_loop.replay_torque_error_max",
+                         "closed_loop.error_rms_ratio",
                          "closed_loop.force_rms_ratio"};
   auto skip_all = [&](const std::string& why) {
     for (const char* n : kAll) s.skipped.push_back({n, why, r.dir});
     return s;
   };
-  if (r.verb != "hw run") return skip_all("not a hw run recording (verb '" + r.verb + "')");
-  if (!r.has("tau_1_Nm")) return skip_all("the trace has no tau_1..3_Nm columns");
+  if (r.verb != "hw run")
+    return skip_all("not a hw run recording (verb '" + r.verb + "')");
+  if (!r.has("tau_1_Nm"))
+    return skip_all("the trace has no tau_1..3_Nm columns");
   std::string scene = o.scene;
-  if (scene.empty() && r.meta.contains("scene") && r.meta["scene"].is_string()) {
+  if (scene.empty() && r.meta.contains("scene") &&
+      r.meta["scene"].is_string()) {
     scene = r.meta["scene"].get<std::string>();
   }
-  if (scene.empty()) return skip_all("meta.json names no scene (give one as an option)");
+  if (scene.empty())
+    return skip_all("meta.json names no scene (give one as an option)");
   std::string gain_source;
   const double gain_scale = gain_scale_of(r, o, &gain_source);
   const std::vector<std::string> overrides = overrides_of(r, o);
-  ControllerParams params = sim::ClosedLoop(scene, overrides).controller_params();
+  ControllerParams params =
+      sim::ClosedLoop(scene, overrides).controller_params();
   scale_gains(gain_scale, &params.gains);
   s.detail["scene"] = scene;
   s.detail["overrides"] = overrides;
@@ -265,19 +299,22 @@ CompareSection compare_closed_loop(const Recording& r, const ReplayOptions& o,
   replay(r, params, o, &s);
 
   if (!o.simulate) {
-    for (int k = 1; k < 3; ++k) s.skipped.push_back({kAll[k], "simulation not asked for", r.dir});
+    for (int k = 1; k < 3; ++k)
+      s.skipped.push_back({kAll[k], "simulation not asked for", r.dir});
   } else if (!r.has("e_1_mm") || !r.has("F_x_N")) {
-    for (int k = 1; k < 3; ++k) s.skipped.push_back({kAll[k], "the trace has no e_*_mm / F_*_N", r.dir});
+    for (int k = 1; k < 3; ++k)
+      s.skipped.push_back({kAll[k], "the trace has no e_*_mm / F_*_N", r.dir});
   } else {
     simulate(r, scene, overrides, gain_scale, o, figure_dir, &s);
   }
   for (const CompareCheck& c : s.checks) {
     if (c.pass) continue;
-    const std::string name = c.name == kAll[0] ? "controller_mismatch"
+    const std::string name = c.name == kAll[0]   ? "controller_mismatch"
                              : c.name == kAll[1] ? "closed_loop_error_level"
                                                  : "closed_loop_force_level";
-    s.faults.push_back({name, c.name + " = " + fmt(c.value) + " " + c.unit + ": " + c.detail,
-                        r.dir});
+    s.faults.push_back(
+        {name, c.name + " = " + fmt(c.value) + " " + c.unit + ": " + c.detail,
+         r.dir});
   }
   return s;
 }

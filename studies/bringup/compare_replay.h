@@ -52,7 +52,7 @@
 namespace vmh::bringup {
 
 struct ReplayOptions {
-  std::string scene;  // empty: meta["scene"]
+  std::string scene;                   // empty: meta["scene"]
   std::vector<std::string> overrides;  // hw run's --set, name=value
   double gain_scale = std::nan("");    // NaN: from the recording, else 1
   double torque_error_max_mNm = 1e-3;

@@ -29,11 +29,11 @@ constexpr double kPi = 3.14159265358979323846;
 
 // What is true of the device that recorded the test
 struct Truth {
-  sim::OmniModelEdit edit;      // the Omni's wiring (motor3_relative)
-  double torque_scale = 1.0;    // units mistaken
+  sim::OmniModelEdit edit;    // the Omni's wiring (motor3_relative)
+  double torque_scale = 1.0;  // units mistaken
   Vec3 motor_sign = Vec3::Ones();
   double reading_delay_s = 0.0;  // readings late
-  ReadingMap map;               // reported = map.reported_from_true(true)
+  ReadingMap map;                // reported = map.reported_from_true(true)
 };
 
 double quantize(double v, double counts_per_rev) {
@@ -45,7 +45,8 @@ double quantize(double v, double counts_per_rev) {
 // then quiet. The command written at a tick reaches the device at the next
 // (as the emulator's threads do), the ticks jitter by a physics step, and
 // one reading before the pulse fails.
-Recording motor_test(int motor, double torque_Nm, double pulse_ms, const Truth& truth) {
+Recording motor_test(int motor, double torque_Nm, double pulse_ms,
+                     const Truth& truth) {
   sim::ClosedLoop loop(kScene, {}, sim::omni_model_hook("", truth.edit));
   const mjModel* m = loop.model();
   mjData* d = loop.data();
@@ -62,11 +63,12 @@ Recording motor_test(int motor, double torque_Nm, double pulse_ms, const Truth& 
   Recording r;
   r.dir = "synthetic-motor" + std::to_string(motor);
   r.verb = "hw motor-test";
-  r.meta = {{"verb", r.verb},
-            {"motor", motor},
-            {"torque_asked_mNm", 1e3 * torque_Nm},
-            {"pulse_ms", pulse_ms},
-            {"emulator", {{"scene", kScene}, {"hand", "none"}, {"model", nullptr}}}};
+  r.meta = {
+      {"verb", r.verb},
+      {"motor", motor},
+      {"torque_asked_mNm", 1e3 * torque_Nm},
+      {"pulse_ms", pulse_ms},
+      {"emulator", {{"scene", kScene}, {"hand", "none"}, {"model", nullptr}}}};
   const double h = m->opt.timestep;
   const double pulse_start_s = 0.08;
   std::vector<double> hist_t;
@@ -81,8 +83,10 @@ Recording motor_test(int motor, double torque_Nm, double pulse_ms, const Truth& 
     std::size_t a = 0;
     while (a + 1 < hist_t.size() && hist_t[a + 1] <= t_read) ++a;
     const std::size_t b = std::min(a + 1, hist_t.size() - 1);
-    const double w = b > a ? (t_read - hist_t[a]) / (hist_t[b] - hist_t[a]) : 0.0;
-    Joints q = truth.map.reported_from_true((1 - w) * hist_q[a] + w * hist_q[b]);
+    const double w =
+        b > a ? (t_read - hist_t[a]) / (hist_t[b] - hist_t[a]) : 0.0;
+    Joints q =
+        truth.map.reported_from_true((1 - w) * hist_q[a] + w * hist_q[b]);
     for (int i = 0; i < 3; ++i) q[i] = quantize(q[i], 15000.0);
     for (int i = 3; i < 6; ++i) q[i] = quantize(q[i], 4096.0);
     const bool failed = k == 30;
@@ -93,19 +97,23 @@ Recording motor_test(int motor, double torque_Nm, double pulse_ms, const Truth& 
     r.num["t_s"].push_back(t);
     const Joints q_dh = device_to_dh_joints(q);
     for (int i = 0; i < 6; ++i) {
-      r.num["q" + std::to_string(i + 1) + "_rad"].push_back(failed ? std::nan("") : q_dh[i]);
+      r.num["q" + std::to_string(i + 1) + "_rad"].push_back(
+          failed ? std::nan("") : q_dh[i]);
     }
     for (int i = 0; i < 3; ++i) {
       char buf[32];
       std::snprintf(buf, sizeof buf, "%.9g", tau[i]);
-      r.num["tau_sent_" + std::to_string(i + 1) + "_Nm"].push_back(std::stod(buf));
+      r.num["tau_sent_" + std::to_string(i + 1) + "_Nm"].push_back(
+          std::stod(buf));
     }
     r.text["read_error"].push_back(failed ? "timeout" : "ok");
     ++r.rows;
     // last tick's command reaches the motors now, as the device has it
-    dev.write_motor_torques(truth.torque_scale * pending.cwiseProduct(truth.motor_sign));
+    dev.write_motor_torques(truth.torque_scale *
+                            pending.cwiseProduct(truth.motor_sign));
     pending = tau;
-    const int n = loop.substeps() + (k % 7 == 3 ? 1 : 0) - (k % 11 == 5 ? 1 : 0);
+    const int n =
+        loop.substeps() + (k % 7 == 3 ? 1 : 0) - (k % 11 == 5 ? 1 : 0);
     for (int i = 0; i < n; ++i) {
       hand.let_go();
       mj_step(m, d);
@@ -126,9 +134,11 @@ std::vector<std::string> fault_names(const CompareSection& s) {
 std::string describe(const CompareSection& s) {
   std::string out;
   for (const CompareCheck& c : s.checks) {
-    out += c.name + "=" + std::to_string(c.value) + (c.pass ? " pass; " : " FAIL; ");
+    out += c.name + "=" + std::to_string(c.value) +
+           (c.pass ? " pass; " : " FAIL; ");
   }
-  for (const SuspectedFault& f : s.faults) out += "fault " + f.name + ": " + f.evidence + "; ";
+  for (const SuspectedFault& f : s.faults)
+    out += "fault " + f.name + ": " + f.evidence + "; ";
   return out;
 }
 
@@ -146,7 +156,8 @@ TEST(CompareForce, CleanRecordingsPassOnEveryMotor) {
     const CompareSection s = compare_force_direction(r, {}, {}, "");
     SCOPED_TRACE("motor " + std::to_string(motor));
     expect_all_pass(s);
-    EXPECT_EQ(s.checks[0].name, "force_direction.motor" + std::to_string(motor) + "_angle");
+    EXPECT_EQ(s.checks[0].name,
+              "force_direction.motor" + std::to_string(motor) + "_angle");
   }
 }
 
@@ -154,10 +165,11 @@ TEST(CompareForce, NamesAFlippedMotor) {
   for (int motor : {1, 3}) {
     Truth t;
     t.motor_sign[motor - 1] = -1.0;
-    const CompareSection s =
-        compare_force_direction(motor_test(motor, kTorque_Nm[motor - 1], 40.0, t), {}, {}, "");
-    EXPECT_EQ(fault_names(s),
-              std::vector<std::string>{"motor" + std::to_string(motor) + "_sign"})
+    const CompareSection s = compare_force_direction(
+        motor_test(motor, kTorque_Nm[motor - 1], 40.0, t), {}, {}, "");
+    EXPECT_EQ(
+        fault_names(s),
+        std::vector<std::string>{"motor" + std::to_string(motor) + "_sign"})
         << describe(s);
     EXPECT_GT(s.checks[0].value, 90.0) << "a reversed motor pushes backwards";
   }
@@ -166,26 +178,33 @@ TEST(CompareForce, NamesAFlippedMotor) {
 TEST(CompareForce, NamesMotor3OnTheRelativeAngle) {
   Truth t;
   t.edit.motor3_relative = true;
-  const CompareSection s = compare_force_direction(motor_test(3, 0.12, 40.0, t), {}, {}, "");
-  EXPECT_EQ(fault_names(s), std::vector<std::string>{"motor3_relative"}) << describe(s);
+  const CompareSection s =
+      compare_force_direction(motor_test(3, 0.12, 40.0, t), {}, {}, "");
+  EXPECT_EQ(fault_names(s), std::vector<std::string>{"motor3_relative"})
+      << describe(s);
 }
 
 TEST(CompareForce, NamesTorqueUnits) {
   Truth big;
   big.torque_scale = 1000.0;
-  CompareSection s = compare_force_direction(motor_test(2, 0.05, 40.0, big), {}, {}, "");
-  EXPECT_EQ(fault_names(s), std::vector<std::string>{"torque_units_Nm"}) << describe(s);
+  CompareSection s =
+      compare_force_direction(motor_test(2, 0.05, 40.0, big), {}, {}, "");
+  EXPECT_EQ(fault_names(s), std::vector<std::string>{"torque_units_Nm"})
+      << describe(s);
   Truth small;
   small.torque_scale = 0.001;
   s = compare_force_direction(motor_test(1, 0.12, 40.0, small), {}, {}, "");
-  EXPECT_EQ(fault_names(s), std::vector<std::string>{"torque_units_mNm"}) << describe(s);
+  EXPECT_EQ(fault_names(s), std::vector<std::string>{"torque_units_mNm"})
+      << describe(s);
 }
 
 TEST(CompareForce, NamesLateReadings) {
   Truth t;
   t.reading_delay_s = 0.005;
-  const CompareSection s = compare_force_direction(motor_test(2, 0.2, 40.0, t), {}, {}, "");
-  EXPECT_EQ(fault_names(s), std::vector<std::string>{"delay_5ms"}) << describe(s);
+  const CompareSection s =
+      compare_force_direction(motor_test(2, 0.2, 40.0, t), {}, {}, "");
+  EXPECT_EQ(fault_names(s), std::vector<std::string>{"delay_5ms"})
+      << describe(s);
   ASSERT_EQ(s.checks.size(), 3u);
   EXPECT_FALSE(s.checks[2].pass);
   // the truth: 5 ms on top of the clean 1 ms, within the search's step
@@ -199,7 +218,8 @@ TEST(CompareForce, ReadsThroughTheReadingMap) {
   const Recording r = motor_test(1, 0.12, 40.0, t);
   // read as reported, joint 1's reading looks like a reversed motor
   const CompareSection raw = compare_force_direction(r, {}, {}, "");
-  EXPECT_EQ(fault_names(raw), std::vector<std::string>{"motor1_sign"}) << describe(raw);
+  EXPECT_EQ(fault_names(raw), std::vector<std::string>{"motor1_sign"})
+      << describe(raw);
   // read through the map kinematics found, the motor is fine
   const CompareSection mapped = compare_force_direction(r, t.map, {}, "");
   expect_all_pass(mapped);
@@ -210,7 +230,8 @@ TEST(CompareForce, NoPulseSkipsWithAReason) {
   const CompareSection s = compare_force_direction(r, {}, {}, "");
   EXPECT_TRUE(s.checks.empty());
   ASSERT_EQ(s.skipped.size(), 3u);
-  EXPECT_NE(s.skipped[0].reason.find("no pulse"), std::string::npos) << s.skipped[0].reason;
+  EXPECT_NE(s.skipped[0].reason.find("no pulse"), std::string::npos)
+      << s.skipped[0].reason;
 }
 
 TEST(CompareForce, BadOptionsAreNamed) {
@@ -221,7 +242,8 @@ TEST(CompareForce, BadOptionsAreNamed) {
     compare_force_direction(r, {}, o, "");
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("gain_max"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("gain_max"), std::string::npos)
+        << e.what();
   }
   Recording bad = r;
   bad.meta["motor"] = 5;
@@ -233,7 +255,8 @@ TEST(CompareForce, WritesTheFigure) {
   const CompareSection s =
       compare_force_direction(motor_test(2, 0.12, 40.0, {}), {}, {}, dir);
   ASSERT_EQ(s.figures.size(), 1u);
-  EXPECT_EQ(std::filesystem::path(s.figures[0]).filename(), "force_direction_motor2.svg");
+  EXPECT_EQ(std::filesystem::path(s.figures[0]).filename(),
+            "force_direction_motor2.svg");
   std::ifstream f(s.figures[0]);
   const std::string text((std::istreambuf_iterator<char>(f)), {});
   EXPECT_NE(text.find("class=\"chart-grid\""), std::string::npos);
@@ -260,21 +283,28 @@ Recording run_with_jacobian(double column1_sign) {
       Joints a = t, b = t;
       a[c] += 1e-6;
       b[c] -= 1e-6;
-      const Vec3 pa = base_to_device_mm(omni, omni_fk(omni, device_to_dh_joints(a)).p_base_m);
-      const Vec3 pb = base_to_device_mm(omni, omni_fk(omni, device_to_dh_joints(b)).p_base_m);
+      const Vec3 pa = base_to_device_mm(
+          omni, omni_fk(omni, device_to_dh_joints(a)).p_base_m);
+      const Vec3 pb = base_to_device_mm(
+          omni, omni_fk(omni, device_to_dh_joints(b)).p_base_m);
       J.block<3, 1>(0, c) = (c == 0 ? column1_sign : 1.0) * (pa - pb) / 2e-6;
     }
     r.num["t_s"].push_back(row.t_s);
-    for (int i = 0; i < 6; ++i) r.num["q" + std::to_string(i + 1) + "_rad"].push_back(row.q_dh[i]);
+    for (int i = 0; i < 6; ++i)
+      r.num["q" + std::to_string(i + 1) + "_rad"].push_back(row.q_dh[i]);
     const char* xyz[] = {"x", "y", "z"};
     for (int i = 0; i < 3; ++i) {
-      r.num[std::string("F_") + xyz[i] + "_N"].push_back(row.out.force_device_N[i]);
-      r.num["tau_" + std::to_string(i + 1) + "_Nm"].push_back(row.out.tau_motor_Nm[i]);
-      r.num["tau_sent_" + std::to_string(i + 1) + "_Nm"].push_back(row.out.tau_motor_Nm[i]);
+      r.num[std::string("F_") + xyz[i] + "_N"].push_back(
+          row.out.force_device_N[i]);
+      r.num["tau_" + std::to_string(i + 1) + "_Nm"].push_back(
+          row.out.tau_motor_Nm[i]);
+      r.num["tau_sent_" + std::to_string(i + 1) + "_Nm"].push_back(
+          row.out.tau_motor_Nm[i]);
     }
     for (int a = 0; a < 6; ++a) {
       for (int c = 0; c < 6; ++c) {
-        r.num["dev_J_" + std::to_string(a + 1) + std::to_string(c + 1)].push_back(J(a, c));
+        r.num["dev_J_" + std::to_string(a + 1) + std::to_string(c + 1)]
+            .push_back(J(a, c));
       }
     }
     r.text["read_error"].push_back("ok");
@@ -285,7 +315,8 @@ Recording run_with_jacobian(double column1_sign) {
 
 TEST(CompareForceMapping, AgreesWithAnFkJacobianAndCatchesAFlippedColumn) {
   const CompareSection good = compare_force_mapping(run_with_jacobian(1.0));
-  ASSERT_EQ(good.checks.size(), 1u) << (good.skipped.empty() ? "" : good.skipped[0].reason);
+  ASSERT_EQ(good.checks.size(), 1u)
+      << (good.skipped.empty() ? "" : good.skipped[0].reason);
   EXPECT_TRUE(good.checks[0].pass) << good.checks[0].detail;
   EXPECT_LT(good.checks[0].value, 1.0);
   EXPECT_GT(good.detail["rows"].get<long>(), 50);
@@ -306,7 +337,8 @@ TEST(CompareForceMapping, SkipsWithoutTheDevicesJacobian) {
   EXPECT_TRUE(s.checks.empty());
   ASSERT_EQ(s.skipped.size(), 1u);
   EXPECT_NE(s.skipped[0].reason.find("Jacobian"), std::string::npos);
-  EXPECT_EQ(compare_force_mapping(motor_test(1, 0.12, 10.0, {})).skipped.size(), 1u);
+  EXPECT_EQ(compare_force_mapping(motor_test(1, 0.12, 10.0, {})).skipped.size(),
+            1u);
 }
 
 }  // namespace

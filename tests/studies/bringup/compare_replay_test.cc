@@ -28,7 +28,8 @@ double printed(double v) {
 // hw_session's format_row writes it: angles NaN on a failed read, the
 // commanded torque zero when the tick was zeroed. meta holds what hw run's
 // meta holds (verb, case, scene).
-Recording run_recording(const std::vector<std::string>& overrides, double duration_s) {
+Recording run_recording(const std::vector<std::string>& overrides,
+                        double duration_s) {
   std::vector<std::string> sets = overrides;
   sets.push_back("duration_s=" + std::to_string(duration_s));
   sim::ClosedLoop loop(kScene, sets);
@@ -47,11 +48,14 @@ Recording run_recording(const std::vector<std::string>& overrides, double durati
           ok ? printed(row.q_dh[i]) : std::nan(""));
     }
     for (int i = 0; i < 3; ++i) {
-      r.num["e_" + std::to_string(i + 1) + "_mm"].push_back(printed(row.out.e[i]));
-      r.num[std::string("F_") + xyz[i] + "_N"].push_back(printed(row.out.force_device_N[i]));
+      r.num["e_" + std::to_string(i + 1) + "_mm"].push_back(
+          printed(row.out.e[i]));
+      r.num[std::string("F_") + xyz[i] + "_N"].push_back(
+          printed(row.out.force_device_N[i]));
       const double tau = row.servo.zeroed ? 0.0 : row.out.tau_motor_Nm[i];
       r.num["tau_" + std::to_string(i + 1) + "_Nm"].push_back(printed(tau));
-      r.num["tau_sent_" + std::to_string(i + 1) + "_Nm"].push_back(printed(tau));
+      r.num["tau_sent_" + std::to_string(i + 1) + "_Nm"].push_back(
+          printed(tau));
     }
     r.text["read_error"].push_back(device_error_name(row.servo.read));
     r.text["write_error"].push_back(device_error_name(row.servo.write));
@@ -68,7 +72,8 @@ const CompareCheck* find(const CompareSection& s, const std::string& name) {
 }
 
 // a count slip on t2 that the device layer's guard refuses
-const std::vector<std::string> kGlitch = {"fault=jump", "fault_joint=2", "fault_at_s=0.4"};
+const std::vector<std::string> kGlitch = {"fault=jump", "fault_joint=2",
+                                          "fault_at_s=0.4"};
 
 TEST(CompareReplay, ReproducesTheRecordedTorques) {
   const Recording r = run_recording(kGlitch, 0.8);
@@ -107,8 +112,11 @@ TEST(CompareReplay, AChangedGainFailsAtTheFirstRowWithAForce) {
   }
   ASSERT_GE(expected, 0);
   ASSERT_TRUE(s.detail["replay"].contains("first_differing_row"));
-  EXPECT_EQ(s.detail["replay"]["first_differing_row"]["row"].get<long>(), expected);
-  EXPECT_NE(c->detail.find("row " + std::to_string(expected)), std::string::npos) << c->detail;
+  EXPECT_EQ(s.detail["replay"]["first_differing_row"]["row"].get<long>(),
+            expected);
+  EXPECT_NE(c->detail.find("row " + std::to_string(expected)),
+            std::string::npos)
+      << c->detail;
   ASSERT_EQ(s.faults.size(), 1u);
 }
 
@@ -121,13 +129,17 @@ TEST(CompareReplay, UsesTheGainScaleTheRecordingNames) {
   EXPECT_TRUE(find(s, "closed_loop.replay_torque_error_max")->pass);
   EXPECT_EQ(s.detail["gain_scale_from"], "meta.json");
   r.meta.erase("gain_scale");
-  EXPECT_FALSE(find(compare_closed_loop(r, o, ""), "closed_loop.replay_torque_error_max")->pass);
+  EXPECT_FALSE(
+      find(compare_closed_loop(r, o, ""), "closed_loop.replay_torque_error_max")
+          ->pass);
 }
 
 TEST(CompareReplay, SimulationMatchesItsOwnSceneAndNotAWeakerController) {
   const std::string dir = ::testing::TempDir() + "/compare_replay_fig";
-  const CompareSection same = compare_closed_loop(run_recording({}, 2.0), {}, dir);
-  for (const char* n : {"closed_loop.error_rms_ratio", "closed_loop.force_rms_ratio"}) {
+  const CompareSection same =
+      compare_closed_loop(run_recording({}, 2.0), {}, dir);
+  for (const char* n :
+       {"closed_loop.error_rms_ratio", "closed_loop.force_rms_ratio"}) {
     const CompareCheck* c = find(same, n);
     ASSERT_NE(c, nullptr) << n;
     EXPECT_TRUE(c->pass) << n << " " << c->value;
@@ -163,7 +175,8 @@ TEST(CompareReplay, SkipsWhatIsNotAHwRunAndNamesBadOptions) {
     compare_closed_loop(r, o, "");
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("ratio_max"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("ratio_max"), std::string::npos)
+        << e.what();
   }
 }
 
