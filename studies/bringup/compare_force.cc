@@ -215,6 +215,12 @@ double response_window_end(const PulseWindow& w, const SimulatedResponse& pred,
   return w.t_end_s;
 }
 
+double peak(const std::vector<double>& v) {
+  double out = 0.0;
+  for (double x : v) out = std::max(out, std::abs(x));
+  return out;
+}
+
 struct Fit {
   double angle_deg = kNan;
   double gain = kNan;
@@ -396,39 +402,61 @@ CompareSection compare_force_direction(const Recording& rec,
   effects(w, by_lag[at], free, t0_fit_s, t1_fit_s, &m, &p);
   const Fit nominal_fit = fit(m, p);
 
-  const std::string at_lag = " at the fitted lag " + fmt(lag_ms) + " ms";
-  s.checks.push_back(make_check(prefix + "_angle", nominal_fit.angle_deg,
-                                o.angle_max_deg, "deg", CompareCheck::kAtMost,
-                                "angle between measured and predicted t1..t3 "
-                                "motion over the response's first " +
-                                    fmt(1e3 * (t1_fit_s - t0_fit_s)) + " ms" +
-                                    at_lag));
-  const CompareCheck gain_lo =
-      make_check(prefix + "_gain", nominal_fit.gain, o.gain_min, "ratio",
-                 CompareCheck::kAtLeast);
-  CompareCheck gain = make_check(
-      prefix + "_gain", nominal_fit.gain, o.gain_max, "ratio",
-      CompareCheck::kAtMost,
-      "least-squares measured/predicted amplitude" + at_lag +
-          ", pass within [" + fmt(o.gain_min) + ", " + fmt(o.gain_max) + "]");
-  gain.pass = gain.pass && gain_lo.pass;
-  s.checks.push_back(gain);
-  s.checks.push_back(
-      make_check(prefix + "_lag", lag_ms, o.lag_baseline_ms + o.lag_excess_ms,
-                 "ms", CompareCheck::kAtMost,
-                 "extra delay (0.." + fmt(o.lag_max_ms) +
-                     " ms) that best fits; a clean recording shows " +
-                     fmt(o.lag_baseline_ms) + " ms"));
-  for (CompareCheck& c : s.checks) c.recording = rec.dir;
-
   // the nominal prediction: a clean device's lag
   const std::size_t base =
       static_cast<std::size_t>(std::lround(o.lag_baseline_ms));
   const SimulatedResponse& nominal = by_lag[std::min(base, by_lag.size() - 1)];
   const double rms0 = rms_error(w, nominal);
+  effects(w, nominal, free, w.t_start_s, w.t_end_s, &m, &p);
+  // a pulse the model says cannot move the arm (into a joint limit, below
+  // the friction) judges nothing; the arm moving anyway still asks why
+  const bool observable = peak(p) >= kMinEffect_rad;
+  const bool moved = peak(m) >= kWindowEffect_rad;
+  if (!observable) {
+    for (const char* c : {"_angle", "_gain", "_lag"}) {
+      s.skipped.push_back(
+          {prefix + c,
+           "the prediction moves t1..t3 less than " +
+               fmt(kMinEffect_rad * 1e3) +
+               " mrad (three encoder counts): a pulse into a joint limit or "
+               "below the friction; ask a larger torque or another pose",
+           rec.dir});
+    }
+  }
+
+  const std::string at_lag = " at the fitted lag " + fmt(lag_ms) + " ms";
+  bool gain_failed = false;
+  if (observable) {
+    s.checks.push_back(make_check(prefix + "_angle", nominal_fit.angle_deg,
+                                  o.angle_max_deg, "deg", CompareCheck::kAtMost,
+                                  "angle between measured and predicted t1..t3 "
+                                  "motion over the response's first " +
+                                      fmt(1e3 * (t1_fit_s - t0_fit_s)) + " ms" +
+                                      at_lag));
+    const CompareCheck gain_lo =
+        make_check(prefix + "_gain", nominal_fit.gain, o.gain_min, "ratio",
+                   CompareCheck::kAtLeast);
+    CompareCheck gain = make_check(
+        prefix + "_gain", nominal_fit.gain, o.gain_max, "ratio",
+        CompareCheck::kAtMost,
+        "least-squares measured/predicted amplitude" + at_lag +
+            ", pass within [" + fmt(o.gain_min) + ", " + fmt(o.gain_max) + "]");
+    gain.pass = gain.pass && gain_lo.pass;
+    gain_failed = !gain.pass;
+    s.checks.push_back(gain);
+    s.checks.push_back(
+        make_check(prefix + "_lag", lag_ms, o.lag_baseline_ms + o.lag_excess_ms,
+                   "ms", CompareCheck::kAtMost,
+                   "extra delay (0.." + fmt(o.lag_max_ms) +
+                       " ms) that best fits; a clean recording shows " +
+                       fmt(o.lag_baseline_ms) + " ms"));
+  }
+  for (CompareCheck& c : s.checks) c.recording = rec.dir;
+
   const bool failed =
-      std::any_of(s.checks.begin(), s.checks.end(),
-                  [](const CompareCheck& c) { return !c.pass; });
+      observable ? std::any_of(s.checks.begin(), s.checks.end(),
+                               [](const CompareCheck& c) { return !c.pass; })
+                 : moved;
   nlohmann::ordered_json hyp_json = nlohmann::ordered_json::array();
   const Hypothesis* named = nullptr;
   std::vector<Hypothesis> hyps;
@@ -446,7 +474,7 @@ CompareSection compare_force_direction(const Recording& rec,
     hyps.push_back(hypothesis("torque_units_Nm", base_s, 1000.0));
     hyps.push_back(hypothesis("torque_units_mNm", base_s, 0.001));
     const double excess_ms = lag_ms - o.lag_baseline_ms;
-    if (excess_ms >= o.lag_excess_ms) {
+    if (observable && excess_ms >= o.lag_excess_ms) {
       hyps.push_back(
           hypothesis("delay_" + std::to_string(std::lround(excess_ms)) + "ms",
                      1e-3 * lag_ms));
@@ -465,7 +493,9 @@ CompareSection compare_force_direction(const Recording& rec,
     if (named != nullptr && !(named->rms_rad < o.hypothesis_ratio * rms0))
       named = nullptr;
     std::string fault, evidence;
-    if (named != nullptr) {
+    if (!observable && named == nullptr) {
+      // moved without a prediction to judge it by: nothing to name
+    } else if (named != nullptr) {
       fault = named->name;
       evidence = named->name + " fits with rms " + fmt(named->rms_rad) +
                  " rad against the nominal's " + fmt(rms0) + " rad";
@@ -473,9 +503,9 @@ CompareSection compare_force_direction(const Recording& rec,
       fault = "torque_units_Nm";
     } else if (nominal_fit.gain < 0.1) {
       fault = "torque_units_mNm";
-    } else if (!gain.pass) {
+    } else if (gain_failed) {
       fault = "motor" + std::to_string(w.motor) + "_gain";
-    } else if (!s.checks[0].pass) {
+    } else if (!s.checks.empty() && !s.checks[0].pass) {
       fault = "motor" + std::to_string(w.motor) + "_direction";
     } else {
       fault = "delay_" +
@@ -486,7 +516,7 @@ CompareSection compare_force_direction(const Recording& rec,
                  fmt(nominal_fit.gain) + ", lag " + fmt(lag_ms) +
                  " ms; no alternative fits clearly better";
     }
-    s.faults.push_back({fault, evidence, rec.dir});
+    if (!fault.empty()) s.faults.push_back({fault, evidence, rec.dir});
   }
 
   nlohmann::ordered_json hist = nlohmann::ordered_json::array();

@@ -49,7 +49,10 @@
 //   0.97-1.00, lag 0-1 ms; a reversed motor 172-177 deg; motor 3 on q3
 //   68 deg and gain 3.6; readings 5 ms late a lag of 6 ms.
 //   No pulse (not a motor test, or tau_sent never nonzero): every check is
-//   skipped with the reason.
+//   skipped with the reason. So are they when the prediction moves t1..t3
+//   less than three encoder counts (a pulse into a joint limit or below
+//   the friction); the arm moving ten counts anyway still tries the
+//   alternatives.
 //   Figure force_direction_motor<N>.svg: t1..t3 measured and predicted
 //   over the window; the same, subsampled, in detail["history"].
 //

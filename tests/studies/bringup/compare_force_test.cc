@@ -234,6 +234,16 @@ TEST(CompareForce, NoPulseSkipsWithAReason) {
       << s.skipped[0].reason;
 }
 
+TEST(CompareForce, APulseTheModelSaysCannotMoveTheArmJudgesNothing) {
+  // 5 mN m on the shoulder does not overcome its friction
+  const CompareSection s =
+      compare_force_direction(motor_test(1, 0.005, 40.0, {}), {}, {}, "");
+  EXPECT_TRUE(s.checks.empty()) << describe(s);
+  ASSERT_EQ(s.skipped.size(), 3u);
+  EXPECT_NE(s.skipped[0].reason.find("joint limit"), std::string::npos);
+  EXPECT_TRUE(s.faults.empty()) << describe(s);
+}
+
 TEST(CompareForce, BadOptionsAreNamed) {
   const Recording r = motor_test(1, 0.06, 10.0, {});
   ForceOptions o;
