@@ -19,13 +19,22 @@
 //     rotation column that matches it best over the recording (column and
 //     sign in detail.rotation_column; a real device's rotation convention is
 //     a fixed unknown rotation away). Justification: the axis depends on
-//     t1..t5; the pots read 11 bits over ranges of 2.3-4.9 rad, a step of
-//     1.1-2.4 mrad, so half a step on two pots plus the encoders is under
+//     t1..t5; the pots read 11 bits over ranges of 2.3-5.2 rad, a step of
+//     1.1-2.5 mrad, so half a step on two pots plus the encoders is under
 //     0.15 deg. 2 deg is ten times that and is what a 35 mrad gimbal offset
 //     produces, well under what a sign or a swap does (tens of degrees).
-// Measured on synthetic recordings (MuJoCo's site pose, sensors quantized,
-// tests/studies/bringup/compare_kinematics_test.cc): clean p95 0.06 mm /
-// 0.07 deg; l1 2 % longer p95 2.7 mm.
+//   kinematics.rotation_error_p95 (deg, at most 2.0): the angle of the whole
+//     stylus-frame error, (R_FK C)^T dev_R, with C the device's fixed
+//     rotation convention fitted over the recording (a signed permutation
+//     when within 10 deg of one). The stylus axis does not see t6; this
+//     does (joint6_sign, a t6 swap). Same justification: the t6 pot's step
+//     is 2.5 mrad (0.07 deg).
+// Measured on synthetic recordings (MuJoCo's site pose, an 8 s tour of all
+// six joints at 1 kHz, angles quantized as the sensors do;
+// tests/studies/bringup/compare_kinematics_test.cc): clean position p95
+// 0.046 mm, max 0.066 mm, stylus axis p95 0.063 deg, rotation p95 0.092 deg
+// (each under a tenth of its threshold); l1 2 % longer: position p95
+// 2.69 mm (fails), fitted l1 136.02 mm against 136.017 mm true.
 //
 // Fault vocabulary (CompareSection::faults), named only when a check fails:
 //   joint<N>_sign (N = 1..6, device joint tN reported negated) and
@@ -45,6 +54,8 @@
 //     sigma (an inkwell calibration off).
 //   kinematics_unexplained: a check fails and neither a reading map nor the
 //     geometry fit explains it.
+// A consistent delay of every column (delay_<M>ms) moves none of these:
+// the angles and the transform stay paired (the motor test catches it).
 // A recording without the dev_* transform columns: every check is skipped
 // (SkippedCheck names the missing columns), nothing is failed.
 #ifndef VMHAPTICS_STUDIES_BRINGUP_COMPARE_KINEMATICS_H_
@@ -70,14 +81,17 @@ inline constexpr double kStylusAxisErrorP95ThresholdDeg = 2.0;
 std::vector<ReadingMap> reading_hypotheses();
 
 // The good rows' (reported device angles read through `map`, device
-// transform) pairs. Throws RecordingError when the transform is missing.
-std::vector<PoseSample> pose_samples(const Recording& rec, const ReadingMap& map);
+// transform) pairs, at most max_samples of them evenly spaced over the
+// recording (0: all). Throws RecordingError when the transform is missing.
+std::vector<PoseSample> pose_samples(const Recording& rec, const ReadingMap& map,
+                                     std::size_t max_samples = 0);
 
 struct ReadingHypothesis {
   ReadingMap map;
   GeometryFit fit;
-  // max(position p95 after the fit / 1.0 mm, rotation p95 / 2 deg): below
-  // 1 when the hypothesis explains the transform
+  // max(position p95 after the fit / 1.0 mm, rotation p95 / 2 deg), at the
+  // nominal geometry when the fit is implausible: below 1 when the
+  // hypothesis explains the transform
   double normalized_p95 = 0.0;
 };
 

@@ -108,8 +108,22 @@ TEST_F(CompareKinematics, CleanPassesWithMarginAndNamesNothing) {
   std::printf("clean jacobian: %s", describe(j).c_str());
 }
 
+// A device whose rotation has the stylus axis in its first column, negated
+// (and the others moved round to keep it a rotation): found, and clean
+TEST_F(CompareKinematics, TheDevicesRotationConventionIsFound) {
+  SyntheticOptions o;
+  o.rotation_convention << 0, -1, 0,
+                           0, 0, 1,
+                           -1, 0, 0;
+  ASSERT_NEAR(o.rotation_convention.determinant(), 1.0, 1e-12);
+  const CompareSection k = compare_kinematics(record(o), "");
+  EXPECT_EQ(k.detail["rotation_column"]["text"], "-column 1");
+  EXPECT_TRUE(all_pass(k)) << describe(k);
+  EXPECT_TRUE(k.faults.empty()) << describe(k);
+}
+
 TEST_F(CompareKinematics, JointSignsAreNamed) {
-  for (int n : {1, 3, 6}) {
+  for (int n = 1; n <= 6; ++n) {
     SyntheticOptions o;
     o.map.sign[n - 1] = -1.0;
     const CompareSection k = compare_kinematics(record(o), "");
@@ -142,6 +156,8 @@ TEST_F(CompareKinematics, LongerUpperArmIsNamedWithItsLength) {
   EXPECT_NEAR(l1, 1.02 * kNominalLinkMm, 0.002 * 1.02 * kNominalLinkMm);
   EXPECT_TRUE(k.detail["geometry_fit"]["explains"].get<bool>());
   std::printf("l1 +2 %%: %sfitted l1 %.3f mm\n", describe(k).c_str(), l1);
+  const CompareSection j = compare_jacobian(record({}, edit), ReadingMap{}, "");
+  std::printf("l1 +2 %% jacobian: %s", describe(j).c_str());
 }
 
 TEST_F(CompareKinematics, ShorterForearmIsNamedNegative) {

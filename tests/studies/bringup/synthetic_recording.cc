@@ -117,7 +117,8 @@ bringup::Recording synthetic_recording(const mjModel* m,
     r.text["read_error"].push_back("ok");
 
     const Vec3 p_base_mm = Eigen::Map<const Vec3>(d->site_xpos + 3 * site) * 1000.0;
-    const Mat3 R_dev = P * Mat3(Eigen::Map<const RowMat3>(d->site_xmat + 9 * site));
+    const Mat3 R_dev = P * Mat3(Eigen::Map<const RowMat3>(d->site_xmat + 9 * site)) *
+                       o.rotation_convention;
     RowJac jp, jr;
     mj_jacSite(m, d, jp.data(), jr.data(), site);
     Mat6 J_q;

@@ -49,6 +49,9 @@ struct SyntheticOptions {
   // joint columns (t): the layouts a real device's API might use
   bool jacobian_transposed = false;
   bool jacobian_dh_columns = false;
+  // the device's own stylus-frame convention: dev_R = R_site * convention
+  // (a real device numbers or signs the stylus axes its own way)
+  Mat3 rotation_convention = Mat3::Identity();
 };
 
 // The recording a device would give of `motion` on model m (an Omni with
