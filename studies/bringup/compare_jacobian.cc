@@ -129,7 +129,7 @@ CompareSection compare_jacobian(const Recording& rec, const ReadingMap& readings
   }
 
   // (b) J(q) qdot against the device's velocity and its positions' differences
-  std::vector<double> tv, speed_project, speed_device, rel_v, rel_fd;
+  std::vector<double> t_moving_s, speed_project_mm_s, speed_device_mm_s, rel_v, rel_fd;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto hi = std::lower_bound(t_s.begin(), t_s.end(), t_s[i] + kVelocityHalfWindowS);
     auto lo = std::upper_bound(t_s.begin(), t_s.end(), t_s[i] - kVelocityHalfWindowS);
@@ -141,8 +141,8 @@ CompareSection compare_jacobian(const Recording& rec, const ReadingMap& readings
     if (!(dt > 0) || dt > 3 * kVelocityHalfWindowS) continue;
     const Joints qdot = (q_true[j] - q_true[k]) / dt;
     const Vec3 v = project_jacobian_dh_columns(params, q_true[i]).topRows<3>() * qdot;
-    tv.push_back(t_s[i]);
-    speed_project.push_back(v.norm());
+    t_moving_s.push_back(t_s[i]);
+    speed_project_mm_s.push_back(v.norm());
     double dev_speed = std::numeric_limits<double>::quiet_NaN();
     if (rec.has_velocity()) {
       const Vec3 dv = rec.dev_v_mm_s(rows[i]);
@@ -151,7 +151,7 @@ CompareSection compare_jacobian(const Recording& rec, const ReadingMap& readings
         rel_v.push_back((v - dv).norm() / dev_speed);
       }
     }
-    speed_device.push_back(dev_speed);
+    speed_device_mm_s.push_back(dev_speed);
     if (has_p) {
       const Vec3 fd = (rec.dev_p_mm(rows[j]) - rec.dev_p_mm(rows[k])) / dt;
       if (fd.allFinite() && fd.norm() > kVelocityMinSpeedMmS) {
@@ -181,15 +181,15 @@ CompareSection compare_jacobian(const Recording& rec, const ReadingMap& readings
   sec.detail["velocity_min_speed_mm_s"] = kVelocityMinSpeedMmS;
   for (CompareCheck& c : sec.checks) c.recording = rec.dir;
 
-  if (!figure_dir.empty() && !tv.empty()) {
+  if (!figure_dir.empty() && !t_moving_s.empty()) {
     report::Chart c;
     c.title = "Project J(q) qdot vs the device's velocity";
     c.subtitle = "recording " + rec.dir + ", device frame";
     c.x.label = "time (s)";
     c.y.label = "wrist speed (mm/s)";
-    c.series.push_back({"|J(q) qdot|", tv, speed_project, "", true, false, false});
+    c.series.push_back({"|J(q) qdot|", t_moving_s, speed_project_mm_s, "", true, false, false});
     if (rec.has_velocity()) {
-      c.series.push_back({"|dev_v|", tv, speed_device, "", true, false, true});
+      c.series.push_back({"|dev_v|", t_moving_s, speed_device_mm_s, "", true, false, true});
     }
     sec.figures.push_back(
         report::write_file_in(figure_dir, "jacobian_velocity.svg", report::chart_svg(c)));

@@ -109,7 +109,8 @@ struct GeometryFit {
   Mat3 convention = Mat3::Identity();  // C
   bool convention_snapped = true;      // C is a signed permutation
   // errors per sample: position |dp| (mm), rotation angle of
-  // (R_model C)^T R_device (deg), nominal C re-estimated for "before"
+  // (R_model C)^T R_device (deg); "before" at the nominal geometry with C
+  // fitted there, "after" at the fitted one
   ErrorStats position_before_mm, position_after_mm;
   ErrorStats rotation_before_deg, rotation_after_deg;
   std::size_t samples_used = 0;

@@ -177,6 +177,25 @@ TEST_F(CompareKinematics, JointOffsetIsNamed) {
   EXPECT_NEAR(fitted, -0.02, 0.001) << "the fit takes the offset back out";
 }
 
+TEST_F(CompareKinematics, BaseOffsetIsNamed) {
+  SyntheticOptions o;
+  o.origin_offset_mm = Vec3(1.5, -0.5, 0.8);
+  const CompareSection k = compare_kinematics(record(o), "");
+  EXPECT_EQ(fault_names(k), std::set<std::string>{"base_offset"}) << describe(k);
+  const auto& params = k.detail["geometry_fit"]["parameters"];
+  EXPECT_NEAR(params[kBaseX]["fitted"].get<double>(), 1.5, 0.05);
+}
+
+// a pot read 5 % high: the fit's gain takes it back out (1 / 1.05)
+TEST_F(CompareKinematics, PotGainIsNamed) {
+  SyntheticOptions o;
+  o.gimbal_gain[1] = 1.05;
+  const CompareSection k = compare_kinematics(record(o), "");
+  EXPECT_EQ(fault_names(k), std::set<std::string>{"joint5_scale"}) << describe(k);
+  const auto& params = k.detail["geometry_fit"]["parameters"];
+  EXPECT_NEAR(params[kScaleT4 + 1]["fitted"].get<double>(), 1.0 / 1.05, 0.003);
+}
+
 TEST_F(CompareKinematics, AConsistentDelayTripsNothing) {
   const Recording r = record({}, {}, 0.005);
   const CompareSection k = compare_kinematics(r, "");

@@ -104,7 +104,9 @@ bringup::Recording synthetic_recording(const mjModel* m,
     for (int i = 0; i < 6; ++i) d->qpos[i] = s.q_dh_rad[i];
     mj_kinematics(m, d);
     mj_comPos(m, d);
-    Joints t = o.map.reported_from_true(sensors.measure(device_from_dh(s.q_dh_rad)));
+    Joints sensed = sensors.measure(device_from_dh(s.q_dh_rad));
+    for (int i = 3; i < 6; ++i) sensed[i] *= o.gimbal_gain[i - 3];
+    Joints t = o.map.reported_from_true(sensed);
     t += o.reported_offset_device_rad;
     if (o.noise_rad > 0) {
       for (int i = 0; i < 6; ++i) t[i] += noise(rng);
@@ -125,7 +127,8 @@ bringup::Recording synthetic_recording(const mjModel* m,
     J_q.topRows<3>() = P * jp * 1000.0;
     J_q.bottomRows<3>() = P * jr;
     if (o.transform) {
-      const Vec3 p = P * p_base_mm + Vec3(0, kNominalLinkMm, -kNominalLinkMm);
+      const Vec3 p = P * p_base_mm + Vec3(0, kNominalLinkMm, -kNominalLinkMm) +
+                     o.origin_offset_mm;
       const char* xyz[] = {"x", "y", "z"};
       for (int i = 0; i < 3; ++i) put(&r, std::string("dev_p_") + xyz[i] + "_mm", p[i]);
       for (int a = 0; a < 3; ++a) {

@@ -37,8 +37,10 @@ struct SyntheticOptions {
   bool quantize = true;
   // the reported device angles: map.reported_from_true(sensed) + offset,
   // plus Gaussian noise of noise_rad (seeded) when > 0
+  // and the pots t4..t6 read with these gains (reported = gain * sensed)
   bringup::ReadingMap map;
   Joints reported_offset_device_rad = Joints::Zero();
+  Vec3 gimbal_gain = Vec3::Ones();
   double noise_rad = 0.0;
   std::uint32_t seed = 1;
   // which of the device's own columns to write
@@ -49,6 +51,9 @@ struct SyntheticOptions {
   // joint columns (t): the layouts a real device's API might use
   bool jacobian_transposed = false;
   bool jacobian_dh_columns = false;
+  // the device frame's origin off (an inkwell calibration off): added to
+  // dev_p, device frame
+  Vec3 origin_offset_mm = Vec3::Zero();
   // the device's own stylus-frame convention: dev_R = R_site * convention
   // (a real device numbers or signs the stylus axes its own way)
   Mat3 rotation_convention = Mat3::Identity();
