@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -194,6 +195,16 @@ TEST_F(CompareKinematics, PotGainIsNamed) {
   EXPECT_EQ(fault_names(k), std::set<std::string>{"joint5_scale"}) << describe(k);
   const auto& params = k.detail["geometry_fit"]["parameters"];
   EXPECT_NEAR(params[kScaleT4 + 1]["fitted"].get<double>(), 1.0 / 1.05, 0.003);
+}
+
+// a wrist position error no geometry or map makes: a 3 mm wobble in x
+TEST_F(CompareKinematics, AnUnexplainedErrorIsSaidToBe) {
+  Recording r = record();
+  std::vector<double>& x = r.num["dev_p_x_mm"];
+  for (std::size_t i = 0; i < r.rows; ++i) x[i] += 3.0 * std::sin(7.0 * r.t_s(i));
+  const CompareSection k = compare_kinematics(r, "");
+  EXPECT_EQ(fault_names(k), std::set<std::string>{"kinematics_unexplained"}) << describe(k);
+  EXPECT_FALSE(k.detail["geometry_fit"]["explains"].get<bool>());
 }
 
 TEST_F(CompareKinematics, AConsistentDelayTripsNothing) {
