@@ -28,6 +28,7 @@
 #include "sim/mujoco_util.h"
 #include "studies/bringup/compare_check.h"
 #include "studies/bringup/compare_force.h"
+#include "studies/bringup/compare_jacobian.h"
 #include "studies/bringup/compare_kinematics.h"
 #include "studies/bringup/compare_replay.h"
 #include "studies/bringup/recording.h"

@@ -20,9 +20,11 @@
 //   - force_direction.motor<N>_lag (ms, at most lag_baseline_ms +
 //     lag_excess_ms): the extra delay, 0..lag_max_ms in 1 ms steps, that
 //     best fits the effect over the window (pulse + settle_ms) with the
-//     amplitude left free. A clean emulator recording shows about 1 ms (the
-//     emulator applies a command one servo period after it is written), a
-//     real device a few; 3 ms more is beyond jitter at 1 kHz.
+//     amplitude left free. Clean emulator recordings show 0 ms (60 mN m,
+//     50 ms pulses on each motor: the prediction already holds the scene's
+//     own command delay), so lag_baseline_ms is 0; a real device's
+//     transport may add a few, to be measured at bring-up and set here.
+//     3 ms more than the baseline is beyond jitter at 1 kHz.
 //   - force_direction.motor<N>_angle (deg, at most angle_max_deg = 25):
 //     the angle between the measured and predicted effects, stacked sample
 //     by sample, over the response's first initial_ms from the fitted lag
@@ -90,7 +92,7 @@ struct ForceOptions {
   double gain_min = 0.5;
   double gain_max = 2.0;
   double lag_max_ms = 30.0;
-  double lag_baseline_ms = 1.0;  // a clean recording's lag
+  double lag_baseline_ms = 0.0;  // a clean recording's lag (the emulator's)
   double lag_excess_ms = 3.0;
   double hypothesis_ratio = 0.5;
 

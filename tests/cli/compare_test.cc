@@ -35,7 +35,7 @@ std::string record_set(const std::string& fault, const fs::path& dir) {
   for (int m = 1; m <= 3; ++m) {
     const fs::path d = dir / ("motor" + std::to_string(m));
     const auto mt = run("hw motor-test --quiet --motor " + std::to_string(m) +
-                        " --torque-mNm 30 --ms 50" + seeded + " --out " + d.string());
+                        " --torque-mNm 60 --ms 50" + seeded + " --out " + d.string());
     EXPECT_EQ(mt.exit_code, 0) << mt.err;
     dirs += " " + d.string();
   }

@@ -22,6 +22,14 @@
 namespace vmh::bringup {
 namespace {
 
+// the synthetic recordings apply each command one tick after it is written
+// (the emulator applies it within the same period: its baseline is 0 ms)
+ForceOptions synthetic_options() {
+  ForceOptions o;
+  o.lag_baseline_ms = 1.0;
+  return o;
+}
+
 const std::string kScene = std::string(VMH_MODELS_DIR) + "/cases/case1.xml";
 // device angles (rad), a pose in the middle of the workspace
 const Joints kQ0 = (Joints() << 0.1, 0.3, 0.2, 0.1, 0.3, -0.2).finished();
@@ -157,7 +165,7 @@ const double kTorque_Nm[3] = {0.12, 0.2, 0.12};
 TEST(CompareForce, CleanRecordingsPassOnEveryMotor) {
   for (int motor = 1; motor <= 3; ++motor) {
     const Recording r = motor_test(motor, kTorque_Nm[motor - 1], 40.0, {});
-    const CompareSection s = compare_force_direction(r, {}, {}, "");
+    const CompareSection s = compare_force_direction(r, {}, synthetic_options(), "");
     SCOPED_TRACE("motor " + std::to_string(motor));
     expect_all_pass(s);
     EXPECT_EQ(s.checks[0].name,
@@ -170,7 +178,7 @@ TEST(CompareForce, ASlowerCleanDeviceStillPasses) {
   Truth t;
   t.command_lag_ticks = 2;
   expect_all_pass(
-      compare_force_direction(motor_test(2, 0.2, 40.0, t), {}, {}, ""));
+      compare_force_direction(motor_test(2, 0.2, 40.0, t), {}, synthetic_options(), ""));
 }
 
 TEST(CompareForce, NamesAFlippedMotor) {
@@ -178,7 +186,7 @@ TEST(CompareForce, NamesAFlippedMotor) {
     Truth t;
     t.motor_sign[motor - 1] = -1.0;
     const CompareSection s = compare_force_direction(
-        motor_test(motor, kTorque_Nm[motor - 1], 40.0, t), {}, {}, "");
+        motor_test(motor, kTorque_Nm[motor - 1], 40.0, t), {}, synthetic_options(), "");
     EXPECT_EQ(
         fault_names(s),
         std::vector<std::string>{"motor" + std::to_string(motor) + "_sign"})
@@ -191,7 +199,7 @@ TEST(CompareForce, NamesMotor3OnTheRelativeAngle) {
   Truth t;
   t.edit.motor3_relative = true;
   const CompareSection s =
-      compare_force_direction(motor_test(3, 0.12, 40.0, t), {}, {}, "");
+      compare_force_direction(motor_test(3, 0.12, 40.0, t), {}, synthetic_options(), "");
   EXPECT_EQ(fault_names(s), std::vector<std::string>{"motor3_relative"})
       << describe(s);
 }
@@ -200,12 +208,12 @@ TEST(CompareForce, NamesTorqueUnits) {
   Truth big;
   big.torque_scale = 1000.0;
   CompareSection s =
-      compare_force_direction(motor_test(2, 0.05, 40.0, big), {}, {}, "");
+      compare_force_direction(motor_test(2, 0.05, 40.0, big), {}, synthetic_options(), "");
   EXPECT_EQ(fault_names(s), std::vector<std::string>{"torque_units_Nm"})
       << describe(s);
   Truth small;
   small.torque_scale = 0.001;
-  s = compare_force_direction(motor_test(1, 0.12, 40.0, small), {}, {}, "");
+  s = compare_force_direction(motor_test(1, 0.12, 40.0, small), {}, synthetic_options(), "");
   EXPECT_EQ(fault_names(s), std::vector<std::string>{"torque_units_mNm"})
       << describe(s);
 }
@@ -214,7 +222,7 @@ TEST(CompareForce, NamesLateReadings) {
   Truth t;
   t.reading_delay_s = 0.005;
   const CompareSection s =
-      compare_force_direction(motor_test(2, 0.2, 40.0, t), {}, {}, "");
+      compare_force_direction(motor_test(2, 0.2, 40.0, t), {}, synthetic_options(), "");
   EXPECT_EQ(fault_names(s), std::vector<std::string>{"delay_5ms"})
       << describe(s);
   ASSERT_EQ(s.checks.size(), 3u);
@@ -229,17 +237,17 @@ TEST(CompareForce, ReadsThroughTheReadingMap) {
   t.map.name = "joint1_sign";
   const Recording r = motor_test(1, 0.12, 40.0, t);
   // read as reported, joint 1's reading looks like a reversed motor
-  const CompareSection raw = compare_force_direction(r, {}, {}, "");
+  const CompareSection raw = compare_force_direction(r, {}, synthetic_options(), "");
   EXPECT_EQ(fault_names(raw), std::vector<std::string>{"motor1_sign"})
       << describe(raw);
   // read through the map kinematics found, the motor is fine
-  const CompareSection mapped = compare_force_direction(r, t.map, {}, "");
+  const CompareSection mapped = compare_force_direction(r, t.map, synthetic_options(), "");
   expect_all_pass(mapped);
 }
 
 TEST(CompareForce, NoPulseSkipsWithAReason) {
   const Recording r = motor_test(1, 0.0, 40.0, {});
-  const CompareSection s = compare_force_direction(r, {}, {}, "");
+  const CompareSection s = compare_force_direction(r, {}, synthetic_options(), "");
   EXPECT_TRUE(s.checks.empty());
   ASSERT_EQ(s.skipped.size(), 3u);
   EXPECT_NE(s.skipped[0].reason.find("no pulse"), std::string::npos)
@@ -249,7 +257,7 @@ TEST(CompareForce, NoPulseSkipsWithAReason) {
 TEST(CompareForce, APulseTheModelSaysCannotMoveTheArmJudgesNothing) {
   // 5 mN m on the shoulder does not overcome its friction
   const CompareSection s =
-      compare_force_direction(motor_test(1, 0.005, 40.0, {}), {}, {}, "");
+      compare_force_direction(motor_test(1, 0.005, 40.0, {}), {}, synthetic_options(), "");
   EXPECT_TRUE(s.checks.empty()) << describe(s);
   ASSERT_EQ(s.skipped.size(), 3u);
   EXPECT_NE(s.skipped[0].reason.find("joint limit"), std::string::npos);
@@ -269,7 +277,7 @@ TEST(CompareForce, BadOptionsAreNamed) {
   }
   Recording bad = r;
   bad.meta["motor"] = 5;
-  EXPECT_THROW(compare_force_direction(bad, {}, {}, ""), std::invalid_argument);
+  EXPECT_THROW(compare_force_direction(bad, {}, synthetic_options(), ""), std::invalid_argument);
 }
 
 TEST(CompareForce, WritesTheFigure) {
