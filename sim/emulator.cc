@@ -9,6 +9,7 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "controller/device_frame.h"
@@ -49,6 +50,13 @@ std::uint64_t serial_hash(const std::string& s) {
     h *= 1099511628211ull;
   }
   return h;
+}
+
+// a number as a person writes it ("2.5", not "2.500000")
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
 }
 
 std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
@@ -159,9 +167,9 @@ Emulator::Emulator(const EmulatorOptions& options) : options_(options) {
     if (std::abs(n - std::round(n)) > 1e-6 || std::round(n) < 1.0 ||
         std::round(n) > kMaxLatePeriods) {
       throw std::invalid_argument(
-          "seeded emulator fault delay_" + std::to_string(options_.seeded.delay_ms) +
+          "seeded emulator fault delay_" + number_text(options_.seeded.delay_ms) +
           "ms: must be a whole number of servo periods (" +
-          std::to_string(1e3 * period_s_) + " ms), 1.." +
+          number_text(1e3 * period_s_) + " ms), 1.." +
           std::to_string(kMaxLatePeriods) + " of them");
     }
     delay_periods_ = static_cast<int>(std::round(n));

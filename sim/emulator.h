@@ -159,10 +159,12 @@ inline constexpr int kMaxLatePeriods = 63;
 //                       (a sign mistake in the host's codec or wiring); the
 //                       raw encoder counts and pot codes and the device's own
 //                       transform, velocity and Jacobian stay true
-//   gimbal_swap         the reported t4 and t6 swapped after decoding (the
-//                       pair whose ranges, +-2.45 and +-2.58 rad, nearly
-//                       agree, so the tour's readings stay in range); raw
-//                       values and kinematics stay true
+//   gimbal_swap         the reported t5 and t6 swapped after decoding (a
+//                       pots' wiring mistake); raw values and kinematics
+//                       stay true. The tour keeps |t6| < 0.9 rad and t5 in
+//                       [0.05, 0.91] rad (measured on case1), inside t5's
+//                       +-1.13 and t6's +-2.58 rad, so the swapped readings
+//                       pass the reading guard; kGimbalSweep's do not
 //   link_length_<P>pct  the real l1 is P % longer (P may be negative or
 //                       decimal): physics and the reported transform use it
 //   delay_<M>ms         every reading (every field, timestamp too) is M ms
@@ -177,7 +179,7 @@ inline constexpr int kMaxLatePeriods = 63;
 //                       inertias, joint dry friction, joint damping times K
 struct SeededFaults {
   std::array<bool, 6> joint_sign{};  // reported t1..t6 negated
-  bool gimbal_swap = false;          // reported t4 <-> t6
+  bool gimbal_swap = false;          // reported t5 <-> t6
   double delay_ms = 0.0;             // 0: none
   double torque_scale = 1.0;         // applied to each written torque
   OmniModelEdit edit;                // link_length, motor*, mass, ...

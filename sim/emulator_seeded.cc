@@ -132,7 +132,7 @@ SeededFaults parse_seeded_faults(const std::string& text) {
 
 void apply_seeded_readings(const SeededFaults& seeded,
                            Joints* q_device_rad) noexcept {
-  if (seeded.gimbal_swap) std::swap((*q_device_rad)[3], (*q_device_rad)[5]);
+  if (seeded.gimbal_swap) std::swap((*q_device_rad)[4], (*q_device_rad)[5]);
   for (int i = 0; i < 6; ++i) {
     if (seeded.joint_sign[static_cast<std::size_t>(i)]) {
       (*q_device_rad)[i] = -(*q_device_rad)[i];

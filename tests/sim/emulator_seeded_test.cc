@@ -88,7 +88,7 @@ TEST(SeededFaults, ReadingsNegatedAndSwapped) {
   q << 0.1, 0.2, 0.3, 0.4, 0.5, 0.6;
   apply_seeded_readings(f, &q);
   Joints expect;
-  expect << 0.1, -0.2, 0.3, 0.6, 0.5, 0.4;
+  expect << 0.1, -0.2, 0.3, 0.4, 0.6, 0.5;
   EXPECT_EQ(q, expect);
   apply_seeded_readings(SeededFaults{}, &q);
   EXPECT_EQ(q, expect);  // no faults: untouched
@@ -122,7 +122,7 @@ TEST(SeededFaults, MissingModelFileIsNamed) {
 }
 
 // joint1_sign and gimbal_swap: the reported angles are the sensor model's
-// (factory calibration: its values to rounding) with t1 negated and t4, t6
+// (factory calibration: its values to rounding) with t1 negated and t5, t6
 // swapped; the raw values and the device's own transform stay true
 TEST(SeededFaults, SignAndSwapChangeOnlyTheReportedAngles) {
   Emulator emu(options("joint1_sign,gimbal_swap"));
@@ -134,9 +134,10 @@ TEST(SeededFaults, SignAndSwapChangeOnlyTheReportedAngles) {
   const OmniParams& p = emu.loop().controller_params().omni;
   const Joints meas = SensorModel(p, true).measure(dh_to_device_joints(t.q_true_dh));
   EXPECT_NEAR(s.q_device_rad[0], -meas[0], 1e-12);
-  EXPECT_NEAR(s.q_device_rad[3], meas[5], 1e-12);
-  EXPECT_NEAR(s.q_device_rad[5], meas[3], 1e-12);
-  for (int i : {1, 2, 4}) EXPECT_NEAR(s.q_device_rad[i], meas[i], 1e-12) << i;
+  EXPECT_NEAR(s.q_device_rad[4], meas[5], 1e-12);
+  EXPECT_NEAR(s.q_device_rad[5], meas[4], 1e-12);
+  for (int i : {1, 2, 3}) EXPECT_NEAR(s.q_device_rad[i], meas[i], 1e-12) << i;
+  EXPECT_GT(std::abs(meas[4] - meas[5]), 1e-3);  // the swap is visible
   EXPECT_GT(std::abs(meas[0]), 1e-3);  // the sign is visible
   // the raw values decode to the true angles
   const Joints raw = hw::angles_from_raw(s.encoder_counts, s.gimbal_pots,
