@@ -90,9 +90,9 @@ void run(const RunOptions& o) {
   }
   std::vector<studies::CaseJob> runs;
   for (const auto& [name, scene] : jobs) {
-    runs.push_back(studies::CaseJob{name, scene, {}, {}, false, model});
+    runs.push_back(studies::CaseJob{name, scene, {}, {}, false});
   }
-  studies::run_cases(&runs, sets, o.out, o.jobs);
+  studies::run_cases(&runs, sets, o.out, o.jobs, model);
   std::vector<studies::CaseResult> results;
   for (const studies::CaseJob& j : runs) {
     if (!j.error.empty()) {

@@ -247,13 +247,14 @@ CaseResult run_case(const std::string& name, const std::string& scene,
 
 void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
-               const std::string& out_dir, int threads) {
+               const std::string& out_dir, int threads,
+               const std::string& model_file) {
   report::parallel_for(jobs->size(), threads > 0 ? threads : report::core_count(),
                [&](std::size_t i) {
                  CaseJob& job = (*jobs)[i];
                  try {
                    job.result = run_case(job.name, job.scene, overrides, out_dir,
-                                         job.model_file);
+                                         model_file);
                  } catch (const SimError& e) {
                    job.error = e.what();
                    job.bad_input = true;

@@ -59,15 +59,16 @@ struct CaseJob {
   CaseResult result;   // filled when error is empty
   std::string error;   // the exception's message, if the run threw
   bool bad_input = false;  // the error was a SimError (bad scene or field)
-  std::string model_file;  // run_case's model_file
 };
 
 // Runs every job through run_case() on `threads` threads (0: one per core,
 // never more than there are jobs), each run in its own thread with its own
 // model and data. Exceptions are caught per job and recorded in it.
+// `model_file`: run_case's, for every job.
 void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
-               const std::string& out_dir, int threads);
+               const std::string& out_dir, int threads,
+               const std::string& model_file = "");
 
 // summary.json's pieces, for other writers of the same format (hw run)
 nlohmann::json claim_json(const Claim& c);
