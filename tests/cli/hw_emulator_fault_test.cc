@@ -96,7 +96,7 @@ TEST(HwEmulatorFault, BadNameIsRefusedNamingIt) {
 }
 
 TEST(HwEmulatorFault, OnlyTheEmulatorTakesThem) {
-  for (const std::string flags :
+  for (const std::string& flags :
        {std::string("--emulator-fault joint1_sign"), "--model " + kOmni}) {
     const auto r = run("hw record --duration 0.5 --device openhaptics " + flags, kEnv);
     EXPECT_EQ(r.exit_code, 2) << flags;
@@ -111,7 +111,7 @@ TEST(HwEmulatorFault, MissingOrBadModelFileIsNamed) {
   fs::create_directories(dir);
   const fs::path bad = dir / "broken.xml";
   std::ofstream(bad) << "<mujoco><worldbody><body";
-  for (const std::string file : {std::string("/nonexistent.xml"), bad.string()}) {
+  for (const std::string& file : {std::string("/nonexistent.xml"), bad.string()}) {
     for (const std::string verb :
          {"hw record --duration 0.5", "hw run case1 --duration 0.5", "run case1"}) {
       const auto r = run(verb + " --model " + file, kEnv);
