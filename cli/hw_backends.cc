@@ -12,6 +12,7 @@
 #include "hw/openhaptics/hd_library.h"
 #include "hw/openhaptics/openhaptics_backend.h"
 #include "sim/emulator.h"
+#include "sim/mujoco_util.h"
 #include "studies/run_case.h"
 
 namespace vmh::cli {
@@ -74,11 +75,36 @@ OpenedDevice open_emulator(const DeviceSpec& spec, const OpenOptions& oo) {
   } catch (const std::exception& e) {
     throw UsageError(std::string("--device emulator: ") + e.what());
   }
+  try {
+    eo.seeded = sim::parse_seeded_faults(oo.seeded);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--emulator-fault: ") + e.what());
+  }
+  if (!oo.model_file.empty()) {
+    std::error_code ec;
+    if (!fs::is_regular_file(oo.model_file, ec)) {
+      throw UsageError("--model: no such file '" + oo.model_file + "'");
+    }
+    eo.model_file = fs::absolute(oo.model_file, ec).string();
+  }
   eo.overrides = oo.overrides;
   eo.hand = hand_program(oo.hand);
-  auto backend = std::make_unique<EmulatorBackend>(eo);
+  std::unique_ptr<EmulatorBackend> backend;
+  try {
+    backend = std::make_unique<EmulatorBackend>(eo);
+  } catch (const sim::SimError& e) {
+    // a bad scene or --model file, named in the message
+    throw UsageError(std::string("--device emulator: ") + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--device emulator: ") + e.what());
+  }
   OpenedDevice dev;
   dev.emulator = backend->emulator();
+  std::error_code ec;
+  dev.scene = fs::absolute(eo.scene, ec).string();
+  dev.hand = oo.hand;
+  dev.model_file = eo.model_file;
+  dev.seeded_faults = eo.seeded.items;
   dev.calibration_source = "factory (the emulator's own)";
   if (oo.load_calibration) {
     std::optional<StoredCalibration> stored;

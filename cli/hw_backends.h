@@ -37,6 +37,10 @@ struct OpenOptions {
   std::vector<std::string> overrides;
   std::string hand = "tour";
   std::string faults;
+  // emulator: seeded faults (sim::parse_seeded_faults) and a calibrated
+  // Omni MJCF replacing the scene's Omni's parameters (empty: none)
+  std::string seeded;
+  std::string model_file;
   // openhaptics: "joint_torque" (HD_CURRENT_JOINT_TORQUE, mN m) or "force"
   // (HD_CURRENT_FORCE, N, device frame)
   std::string hd_command = "joint_torque";
@@ -46,11 +50,17 @@ struct OpenOptions {
 
 // An opened backend. `emulator` is set when it is the emulator (for its
 // ground truth, hand programs and faults); `calibration_source` says where
-// the joint-angle calibration in use came from.
+// the joint-angle calibration in use came from. The emulator's setup, for
+// meta.json: its scene (absolute path), hand program at the start, model
+// file (absolute; empty: none) and seeded faults (hidden from analyses).
 struct OpenedDevice {
   std::unique_ptr<DeviceBackend> backend;
   sim::Emulator* emulator = nullptr;
   std::string calibration_source;
+  std::string scene;
+  std::string hand;
+  std::string model_file;
+  std::vector<std::string> seeded_faults;
 };
 
 // Throws DeviceOpenError (the cause in one line) or UsageError.

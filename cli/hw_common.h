@@ -18,6 +18,8 @@ struct HwCommon {
   std::string device = "emulator";
   std::string hand;        // emulator: who holds the stylus (verb default)
   std::string faults;      // emulator: injected transport faults
+  std::string seeded;      // emulator: seeded faults (--emulator-fault)
+  std::string model;       // emulator: a calibrated Omni MJCF (--model)
   std::string hd_command = "joint_torque";
   bool no_realtime = false;
   bool require_deadman = false;
@@ -25,12 +27,14 @@ struct HwCommon {
   bool quiet = false;
 };
 
-// Adds --device, --hand, --fault, --hd-command, --no-realtime,
-// --require-deadman, --no-calibration and --quiet to a verb.
+// Adds --device, --hand, --fault, --emulator-fault, --model, --hd-command,
+// --no-realtime, --require-deadman, --no-calibration and --quiet to a verb.
 void add_hw_common(CLI::App* cmd, HwCommon* c);
 
 // Opens the device named by c.device (UsageError for an unknown backend,
-// DeviceOpenError for one that cannot be opened).
+// for --emulator-fault or --model with another backend than the emulator,
+// for a bad fault name or model file; DeviceOpenError for a device that
+// cannot be opened).
 OpenedDevice open_hw_device(const HwCommon& c, const std::string& default_hand,
                             const std::vector<std::string>& overrides = {});
 
@@ -38,7 +42,10 @@ OpenedDevice open_hw_device(const HwCommon& c, const std::string& default_hand,
 SessionOptions session_options(const HwCommon& c, const std::string& verb);
 
 // identity, calibration, software version and date, the servo thread's
-// report and timing, the stop reason: what meta.json holds
+// report and timing, the stop reason: what meta.json holds; on the
+// emulator also "emulator": its scene (absolute path), hand program, model
+// file (or null) and, as the emulator's hidden setup for tests,
+// "seeded_faults"
 Json identity_json(const DeviceIdentity& id);
 Json timing_json(const TickStats& t);
 Json session_json(const SessionResult& r);

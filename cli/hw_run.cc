@@ -1,13 +1,17 @@
 // vmhaptics hw run [--device D] <case1..case6|scene.xml> [--duration s]
 //                  [--out DIR] [--set name=value ...] [--gain-scale x]
+//                  [--model FILE] [--emulator-fault LIST]
 //
 // The scene's controller on a device, through the same servo_tick as `run`
 // and the safety layer. DIR/trace.csv has run's columns for the same
 // quantities plus the device's and the safety layer's; DIR/summary.json the
 // session and, on the emulator, the same metrics and thesis claims as
 // `run` (measured on the emulator's ground truth); DIR/meta.json the device.
+// --model FILE (emulator only) replaces the Omni's parameters both in the
+// emulator's scene and in the run's own model, which the claims measure on.
 // Exit codes as the other hw verbs, and 1 when a claim fails.
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -79,8 +83,16 @@ void hw_run(const HwRunOptions& o) {
   }
   // the scene's parameters, its script and the claims' geometry
   std::unique_ptr<sim::ClosedLoop> model;
+  if (!o.common.model.empty() && !std::filesystem::is_regular_file(o.common.model)) {
+    throw UsageError("--model: no such file '" + o.common.model + "'");
+  }
+  if (!o.common.model.empty() && parse_device_spec(o.common.device).backend != "emulator") {
+    throw UsageError("--model: only the emulator simulates a model, not --device " +
+                     o.common.device);
+  }
   try {
-    model = std::make_unique<sim::ClosedLoop>(scene, sets);
+    model = std::make_unique<sim::ClosedLoop>(scene, sets,
+                                              sim::omni_model_hook(o.common.model));
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("hw run: ") + e.what());
   }
@@ -126,6 +138,7 @@ void hw_run(const HwRunOptions& o) {
                {"scene", scene},
                {"thesis_case", thesis_case},
                {"gain_scale", o.gain_scale},
+               {"model", dev.model_file.empty() ? Json(nullptr) : Json(dev.model_file)},
                {"session", session_json(r)}};
   bool claims_pass = true;
   std::string failed;

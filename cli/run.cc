@@ -1,5 +1,5 @@
 // vmhaptics run <case1..case6|scene.xml> [--duration s] [--out DIR]
-//                [--set name=value ...] [--json]
+//                [--set name=value ...] [--json] [--model FILE]
 // vmhaptics run --all [--out DIR] [--jobs N]
 //
 // Prints a table of the error to the path against the run time (or, with
@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "cli/args.h"
@@ -27,6 +28,7 @@ struct RunOptions {
   std::vector<std::string> sets;
   int jobs = 0;  // 0: one per core
   bool json = false;
+  std::string model;  // a calibrated Omni MJCF; empty: the scene's own
 };
 
 void print_table(const std::vector<studies::CaseResult>& results) {
@@ -78,11 +80,19 @@ void run(const RunOptions& o) {
     throw UsageError(std::string("run: ") + e.what());
   }
 
+  std::string model;
+  if (!o.model.empty()) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(o.model, ec)) {
+      throw UsageError("--model: no such file '" + o.model + "'");
+    }
+    model = std::filesystem::absolute(o.model, ec).string();
+  }
   std::vector<studies::CaseJob> runs;
   for (const auto& [name, scene] : jobs) {
     runs.push_back(studies::CaseJob{name, scene, {}, {}, false});
   }
-  studies::run_cases(&runs, sets, o.out, o.jobs);
+  studies::run_cases(&runs, sets, o.out, o.jobs, model);
   std::vector<studies::CaseResult> results;
   for (const studies::CaseJob& j : runs) {
     if (!j.error.empty()) {
@@ -140,6 +150,10 @@ void register_run(CLI::App* app) {
       ->allow_extra_args(false);
   cmd->add_option("--jobs", o->jobs,
                   "cases run in parallel (default: one per core)");
+  cmd->add_option("--model", o->model,
+                  "a calibrated Omni MJCF (e.g. models/omni/calibrated/"
+                  "<serial>.xml, any MJCF with models/omni/omni.xml's names) "
+                  "whose parameters replace the scene's Omni's");
   cmd->add_flag("--json", o->json,
                 "print every case's summary as one JSON object instead of "
                 "the table");

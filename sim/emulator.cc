@@ -9,6 +9,7 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "controller/device_frame.h"
@@ -16,6 +17,7 @@
 #include "device/tick_timer.h"
 #include "sim/closed_loop.h"
 #include "sim/emulator_hand.h"
+#include "sim/emulator_kinematics.h"
 #include "sim/sensor_model.h"
 
 #ifndef VMH_DEFAULT_MODELS_DIR
@@ -48,6 +50,13 @@ std::uint64_t serial_hash(const std::string& s) {
     h *= 1099511628211ull;
   }
   return h;
+}
+
+// a number as a person writes it ("2.5", not "2.500000")
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
 }
 
 std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
@@ -98,7 +107,9 @@ hw::OmniCalibration factory_for(const std::string& serial,
 
 struct Emulator::PhysicsState {
   explicit PhysicsState(ClosedLoop* loop)
-      : hand(loop), sensor(loop->controller_params().omni, true) {
+      : hand(loop),
+        sensor(loop->controller_params().omni, true),
+        kinematics(loop->model(), loop->controller_params().omni) {
     const mjModel* m = loop->model();
     qpos_before.assign(static_cast<std::size_t>(m->nq), 0.0);
     dq.assign(static_cast<std::size_t>(m->nv), 0.0);
@@ -106,6 +117,7 @@ struct Emulator::PhysicsState {
   }
   EmulatorHand hand;
   SensorModel sensor;  // always quantising (see the header)
+  EmulatorKinematics kinematics;
   std::vector<mjtNum> qpos_before, dq, mv;
   // past readings, for a late fault
   std::array<Published, kMaxLatePeriods + 1> ring{};
@@ -145,8 +157,23 @@ Emulator::Emulator(const EmulatorOptions& options) : options_(options) {
   if (options_.scene.empty()) {
     options_.scene = std::string(VMH_DEFAULT_MODELS_DIR) + "/cases/case1.xml";
   }
-  loop_ = std::make_unique<ClosedLoop>(options_.scene, options_.overrides);
+  loop_ = std::make_unique<ClosedLoop>(
+      options_.scene, options_.overrides,
+      omni_model_hook(options_.model_file, options_.seeded.edit));
   period_s_ = loop_->controller_params().servo_period_s;
+  if (options_.seeded.delay_ms > 0.0) {
+    // the late-snapshot ring keeps whole periods only
+    const double n = options_.seeded.delay_ms * 1e-3 / period_s_;
+    if (std::abs(n - std::round(n)) > 1e-6 || std::round(n) < 1.0 ||
+        std::round(n) > kMaxLatePeriods) {
+      throw std::invalid_argument(
+          "seeded emulator fault delay_" + number_text(options_.seeded.delay_ms) +
+          "ms: must be a whole number of servo periods (" +
+          number_text(1e3 * period_s_) + " ms), 1.." +
+          std::to_string(kMaxLatePeriods) + " of them");
+    }
+    delay_periods_ = static_cast<int>(std::round(n));
+  }
   substeps_ = loop_->substeps();
   factory_ = factory_for(options_.serial, loop_->controller_params().omni);
   cal_.write(factory_);
@@ -301,7 +328,8 @@ Vec3 Emulator::motor_command(double now_s) noexcept {
     ps.watchdog_fired = true;
     return Vec3::Zero();
   }
-  return c.tau_Nm;
+  // torque_units_*: the device reads the host's numbers in other units
+  return options_.seeded.torque_scale * c.tau_Nm;
 }
 
 double Emulator::step_period() noexcept {
@@ -354,16 +382,21 @@ void Emulator::publish(double now_s) noexcept {
     s.encoder_counts = hw::encoder_counts_from_angles(q_meas.head<3>(), factory_);
     s.gimbal_pots = hw::pot_codes_from_angles(q_meas.tail<3>(), factory_);
     s.q_device_rad = hw::angles_from_raw(s.encoder_counts, s.gimbal_pots, cal_.read());
+    apply_seeded_readings(options_.seeded, &s.q_device_rad);
     s.docked = ps.hand.docked(q_dh, &t.p_true_mm, &t.stylus_axis);
+    ps.kinematics.fill(m, d, &s);
   }
   s.timestamp_s = now_s;
-  s.present = kStateJoints | kStateButtons | kStateInkwell | kStateTimestamp |
+  s.present |= kStateJoints | kStateButtons | kStateInkwell | kStateTimestamp |
               kStateEncoders | kStatePots;
   ps.ring[static_cast<std::size_t>(ps.periods % (kMaxLatePeriods + 1))] = p;
-  if (ps.late_count > 0 && ps.periods >= ps.late_count) {
-    // a late reading: an old snapshot, with its old timestamp, delivered now
+  const long late = std::min<long>(ps.late_count + delay_periods_, kMaxLatePeriods);
+  if (late > 0 && (ps.periods >= late || delay_periods_ > 0)) {
+    // a late reading: an old snapshot, with its old timestamp, delivered
+    // now (a seeded delay: the first snapshot until there is an old enough
+    // one, as a device's first readings would be)
     Published old = ps.ring[static_cast<std::size_t>(
-        (ps.periods - ps.late_count) % (kMaxLatePeriods + 1))];
+        std::max(0L, ps.periods - late) % (kMaxLatePeriods + 1))];
     old.publish_wall_s = now_s;
     state_.write(old);
   } else {

@@ -36,9 +36,37 @@
 //
 // Torque sign: positive motor torque on t1 turns t1 positively (device
 // convention), through SimDevice and the model's actuators.
+//
+// The device's own kinematics (kStateTransform, kStateVelocity,
+// kStateJacobian, as OpenHaptics's HD_CURRENT_TRANSFORM, _VELOCITY and
+// _JACOBIAN), computed from the TRUE MuJoCo state at the end of the period
+// (sim/emulator_kinematics.h), not from controller/ code, so that a
+// comparison with the project's own kinematics is a real check. The DH
+// base frame is the MuJoCo world frame of models/omni; the device frame is
+// controller/device_frame.h's, placed with the scene's nominal OmniParams.
+//   transform_mm: the site "wrist" (the wrist centre, the stylus body's
+//     origin). Translation (0..2, 3): base_to_device_mm(site_xpos), mm.
+//     Rotation (0..2, 0..2): base_to_device_rotation(site_xmat): its
+//     columns are the DH stylus frame's axes (frame 6; z along the stylus)
+//     in the device frame. Stored in Eigen's (column-major) order, so
+//     transform_mm(r, c) is row r, column c. OpenHaptics's own stylus
+//     rotation is a fixed rotation away from this one (unverified on a
+//     device).
+//   velocity_mm_s: the wrist site's linear velocity (mj_jacSite times
+//     qvel), device frame, mm/s.
+//   jacobian(r, c) = d x_r / d t_c: rows v_x, v_y, v_z (mm/rad) then
+//     w_x, w_y, w_z (rad/rad), device frame; columns the DEVICE joints
+//     t1..t6 (t3 the absolute forearm angle). By the chain rule through
+//     q_dh = device_to_dh_joints(t) (q1 = -t1, q3 = t3 - t2, q4 = -t4,
+//     q6 = -t6) the columns are mj_jacSite's DH columns (-J1, J2 - J3, J3,
+//     -J4, J5, -J6), rotated into the device frame.
+// They are part of the published snapshot, so a late reading is late in
+// every field. Seeded faults (SeededFaults) leave them true: they are what
+// the device itself computes from its own sensors.
 #ifndef VMHAPTICS_SIM_EMULATOR_H_
 #define VMHAPTICS_SIM_EMULATOR_H_
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -51,6 +79,7 @@
 #include "device/seqlock.h"
 #include "hw/omni_calibration.h"
 #include "sim/hand_script.h"
+#include "sim/omni_model_edit.h"
 
 namespace vmh::sim {
 
@@ -121,6 +150,50 @@ struct EmulatorFault {
 };
 inline constexpr int kMaxLatePeriods = 63;
 
+// Seeded faults: a mistake built into the emulated device (or into the
+// host's view of it) for the whole session, for bring-up's `compare` to
+// find. Hidden: nothing a session writes to its trace carries them; meta.json
+// records them only under "emulator" (the emulator's setup, for tests).
+// Text form (parse_seeded_faults), comma-separated, combinable:
+//   joint<N>_sign       N = 1..6: the reported t_N is negated after decoding
+//                       (a sign mistake in the host's codec or wiring); the
+//                       raw encoder counts and pot codes and the device's own
+//                       transform, velocity and Jacobian stay true
+//   gimbal_swap         the reported t5 and t6 swapped after decoding (a
+//                       pots' wiring mistake); raw values and kinematics
+//                       stay true. The tour keeps |t6| < 0.9 rad and t5 in
+//                       [0.05, 0.91] rad (measured on case1), inside t5's
+//                       +-1.13 and t6's +-2.58 rad, so the swapped readings
+//                       pass the reading guard; kGimbalSweep's do not
+//   link_length_<P>pct  the real l1 is P % longer (P may be negative or
+//                       decimal): physics and the reported transform use it
+//   delay_<M>ms         every reading (every field, timestamp too) is M ms
+//                       late: a whole number of servo periods, at most
+//                       kMaxLatePeriods
+//   motor3_relative     motor 3 turns the relative elbow angle q3
+//   motor<N>_sign       N = 1..3: that motor turns the other way
+//   torque_units_Nm     each written torque taken 1000x (mN m read as N m;
+//                       the motors' clamps then limit it)
+//   torque_units_mNm    each written torque taken 0.001x
+//   mass_x<K>, friction_x<K>, damping_x<K>   K > 0: the Omni's masses and
+//                       inertias, joint dry friction, joint damping times K
+struct SeededFaults {
+  std::array<bool, 6> joint_sign{};  // reported t1..t6 negated
+  bool gimbal_swap = false;          // reported t5 <-> t6
+  double delay_ms = 0.0;             // 0: none
+  double torque_scale = 1.0;         // applied to each written torque
+  OmniModelEdit edit;                // link_length, motor*, mass, ...
+  std::vector<std::string> items;    // the list as given, in order
+
+  bool any() const { return !items.empty(); }
+};
+// Throws std::invalid_argument naming the bad item and listing the names.
+SeededFaults parse_seeded_faults(const std::string& text);
+// The reported joint angles as the seeded faults make them (device
+// convention, rad). Real-time: no allocation.
+void apply_seeded_readings(const SeededFaults& seeded,
+                           Joints* q_device_rad) noexcept;
+
 // "drop@1.0:5,late@2.0:0.5:3,stall@3:0.2,unplug@4:1": kind@at_s then
 // drop:count, late:duration_s:count, stall:duration_s, unplug:duration_s.
 // Empty text: no faults. Throws std::invalid_argument naming the bad item.
@@ -142,6 +215,10 @@ struct EmulatorOptions {
   std::string serial = "EMU-0001";
   std::vector<EmulatorFault> faults;
   double device_watchdog_s = 0.05;  // <= 0: no device watchdog
+  // a calibrated Omni MJCF whose parameters replace the scene's Omni's
+  // (sim::omni_model_hook; `--model FILE`); empty: the scene's own
+  std::string model_file;
+  SeededFaults seeded;  // the device's hidden built-in mistakes
 };
 
 // Ground truth of the last period, for tests and for the trace of a
@@ -177,8 +254,10 @@ struct EmulatorTruth {
 
 class Emulator final : public HapticDevice {
  public:
-  // Loads the scene (throws SimError naming the file and field) and checks
-  // the options (std::invalid_argument naming the field). Does not start.
+  // Loads the scene with options.model_file and the seeded faults' model
+  // edit applied (throws SimError naming the file and field) and checks
+  // the options (std::invalid_argument naming the field; a seeded delay
+  // that is not a whole number of servo periods). Does not start.
   explicit Emulator(const EmulatorOptions& options);
   ~Emulator() override;
   Emulator(const Emulator&) = delete;
@@ -220,6 +299,8 @@ class Emulator final : public HapticDevice {
   // the scene's loop (model, script, path): read-only use while running
   const ClosedLoop& loop() const { return *loop_; }
   double servo_period_s() const noexcept { return period_s_; }
+  // the seeded delay in servo periods (EmulatorOptions::seeded.delay_ms)
+  int delay_periods() const noexcept { return delay_periods_; }
   // the inkwell's wrist centre (mm) and stylus axis, device frame
   Vec3 inkwell_mm() const noexcept;
   Vec3 inkwell_axis() const noexcept;
@@ -255,6 +336,7 @@ class Emulator final : public HapticDevice {
   std::unique_ptr<ClosedLoop> loop_;
   double period_s_ = 1e-3;
   int substeps_ = 1;
+  int delay_periods_ = 0;
   hw::OmniCalibration factory_;
 
   std::thread thread_;

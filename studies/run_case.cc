@@ -153,12 +153,13 @@ std::vector<std::string> trace_columns(int vm_dof) {
 
 CaseResult run_case(const std::string& name, const std::string& scene,
                     const std::vector<std::string>& overrides,
-                    const std::string& out_dir) {
+                    const std::string& out_dir,
+                    const std::string& model_file) {
   CaseResult result;
   result.name = name;
   result.scene = scene;
 
-  ClosedLoop loop(scene, overrides);
+  ClosedLoop loop(scene, overrides, omni_model_hook(model_file));
   const int thesis_case = loop.config().thesis_case;
   if (auto ref = reference_params(thesis_case, loop.controller_params())) {
     loop.set_reference(*ref);
@@ -213,6 +214,7 @@ CaseResult run_case(const std::string& name, const std::string& scene,
       {"case", name},
       {"scene", scene},
       {"thesis_case", thesis_case},
+      {"model", model_file.empty() ? nlohmann::json(nullptr) : nlohmann::json(model_file)},
       {"simulated_s", result.simulated_s},
       {"wall_time_s", result.wall_time_s},
       {"realtime_factor", result.simulated_s / std::max(result.wall_time_s, 1e-9)},
@@ -245,12 +247,14 @@ CaseResult run_case(const std::string& name, const std::string& scene,
 
 void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
-               const std::string& out_dir, int threads) {
+               const std::string& out_dir, int threads,
+               const std::string& model_file) {
   report::parallel_for(jobs->size(), threads > 0 ? threads : report::core_count(),
                [&](std::size_t i) {
                  CaseJob& job = (*jobs)[i];
                  try {
-                   job.result = run_case(job.name, job.scene, overrides, out_dir);
+                   job.result = run_case(job.name, job.scene, overrides, out_dir,
+                                         model_file);
                  } catch (const SimError& e) {
                    job.error = e.what();
                    job.bad_input = true;

@@ -43,10 +43,14 @@ struct CaseResult {
 
 // Runs `scene` (with `overrides`) for its duration and, if out_dir is not
 // empty, writes out_dir/<name>/{trace.csv, summary.json, views.svg,
-// history.svg}. Throws SimError on bad input (before anything is written).
+// history.svg}. `model_file` (not empty): a calibrated Omni MJCF whose
+// parameters replace the scene's Omni's (sim::omni_model_hook; recorded in
+// summary.json's "model"). Throws SimError on bad input (before anything is
+// written).
 CaseResult run_case(const std::string& name, const std::string& scene,
                     const std::vector<std::string>& overrides,
-                    const std::string& out_dir);
+                    const std::string& out_dir,
+                    const std::string& model_file = "");
 
 // One run of run_cases(): the case's name and scene, and what came of it.
 struct CaseJob {
@@ -60,9 +64,11 @@ struct CaseJob {
 // Runs every job through run_case() on `threads` threads (0: one per core,
 // never more than there are jobs), each run in its own thread with its own
 // model and data. Exceptions are caught per job and recorded in it.
+// `model_file`: run_case's, for every job.
 void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
-               const std::string& out_dir, int threads);
+               const std::string& out_dir, int threads,
+               const std::string& model_file = "");
 
 // summary.json's pieces, for other writers of the same format (hw run)
 nlohmann::json claim_json(const Claim& c);

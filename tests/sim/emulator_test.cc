@@ -82,13 +82,14 @@ TEST(Emulator, ReadsAdvanceWithIncreasingTimestamps) {
     EXPECT_GT(periods, last_periods);
     last_periods = periods;
   }
+  // the device's own kinematics too, as OpenHaptics reports them
+  // (emulator_kinematics_test.cc checks their values); no safety switch
   for (DeviceStateField f : {kStateJoints, kStateButtons, kStateInkwell,
-                             kStateTimestamp, kStateEncoders, kStatePots}) {
+                             kStateTimestamp, kStateEncoders, kStatePots,
+                             kStateTransform, kStateVelocity, kStateJacobian}) {
     EXPECT_TRUE(s.has(f)) << f;
   }
-  // not OpenHaptics: no transform, velocity or Jacobian
-  EXPECT_FALSE(s.has(kStateTransform));
-  EXPECT_FALSE(s.has(kStateJacobian));
+  EXPECT_FALSE(s.has(kStateSafetySwitch));
   emu.press_buttons(kButton1 | kButton2);
   ASSERT_EQ(read_ok(&emu, &s), DeviceError::kOk);
   EXPECT_EQ(s.buttons, kButton1 | kButton2);
