@@ -15,6 +15,8 @@
 // is printed first); 2 on bad input (a directory that is not a recording).
 #include "cli/compare.h"
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -46,6 +48,44 @@ struct CompareOptions {
   std::string scene;  // to predict with when a recording does not name one
 };
 
+// how far the recording moves the joints: the sum over t1..t6 of each
+// angle's 5th-95th percentile spread, rad
+double joint_excursion_rad(const Recording& r) {
+  const std::vector<std::size_t> rows = r.good_rows();
+  if (rows.size() < 2) return 0.0;
+  double sum = 0.0;
+  for (int j = 1; j <= 6; ++j) {
+    const std::vector<double>& q = r.col("q" + std::to_string(j) + "_rad");
+    std::vector<double> v;
+    v.reserve(rows.size());
+    for (std::size_t k : rows) v.push_back(q[k]);
+    std::sort(v.begin(), v.end());
+    sum += v[v.size() * 95 / 100] - v[v.size() * 5 / 100];
+  }
+  return sum;
+}
+
+// A delay is the device's, not one pulse's: the motor tests' delay_<M>ms
+// are merged into one with M their median (each lag is found to the
+// millisecond, so one test of three may land a step off)
+void merge_delays(std::vector<bringup::SuspectedFault>* faults) {
+  std::vector<long> ms;
+  for (const bringup::SuspectedFault& f : *faults) {
+    long m = 0;
+    if (std::sscanf(f.name.c_str(), "delay_%ldms", &m) == 1) ms.push_back(m);
+  }
+  if (ms.size() < 2) return;
+  std::sort(ms.begin(), ms.end());
+  const std::string name = "delay_" + std::to_string(ms[ms.size() / 2]) + "ms";
+  for (bringup::SuspectedFault& f : *faults) {
+    long m = 0;
+    if (std::sscanf(f.name.c_str(), "delay_%ldms", &m) == 1 && f.name != name) {
+      f.evidence += " (merged: the median of the motor tests' delays is " + name + ")";
+      f.name = name;
+    }
+  }
+}
+
 // where a recording's figures go: DIR/<recording's folder name>/
 std::string figure_dir(const CompareOptions& o, const Recording& r) {
   if (o.out.empty()) return {};
@@ -66,29 +106,50 @@ void compare(const CompareOptions& o) {
   }
 
   std::vector<CompareSection> sections;
-  // the readings' map: from each recording that reports a transform; one
-  // that does not takes the map the others agree on
-  std::vector<bringup::ReadingMap> maps(recs.size());
-  bringup::ReadingMap shared;
+  // The readings' map and the kinematics are judged on the recording that
+  // moves the joints most (the workspace tour): a motor test moves little,
+  // and a fit of the geometry to a few poses can explain a sign away as an
+  // offset. Recordings that move at least half as much are judged too; the
+  // map found applies to every recording (one device, one codec).
+  std::vector<double> excitation(recs.size(), 0.0);
+  std::size_t richest = recs.size();
   for (std::size_t i = 0; i < recs.size(); ++i) {
-    if (!recs[i].has_transform()) continue;
-    maps[i] = bringup::diagnose_readings(recs[i]).map;
-    if (!maps[i].is_identity()) shared = maps[i];
+    excitation[i] = joint_excursion_rad(recs[i]);
+    if (recs[i].has_transform() &&
+        (richest == recs.size() || excitation[i] > excitation[richest])) {
+      richest = i;
+    }
   }
+  bringup::ReadingMap shared;
+  if (richest < recs.size()) shared = bringup::diagnose_readings(recs[richest]).map;
+  std::vector<bool> judge_kinematics(recs.size(), true);
   for (std::size_t i = 0; i < recs.size(); ++i) {
-    if (!recs[i].has_transform()) maps[i] = shared;
+    if (richest < recs.size() && i != richest &&
+        excitation[i] < 0.5 * excitation[richest]) {
+      judge_kinematics[i] = false;
+    }
   }
 
   try {
     for (std::size_t i = 0; i < recs.size(); ++i) {
       const Recording& r = recs[i];
       const std::string figs = figure_dir(o, r);
-      sections.push_back(bringup::compare_kinematics(r, figs));
-      sections.push_back(bringup::compare_jacobian(r, maps[i], figs));
+      if (judge_kinematics[i]) {
+        sections.push_back(bringup::compare_kinematics(r, figs));
+      } else {
+        CompareSection k;
+        k.name = "kinematics";
+        k.skipped.push_back({"kinematics.*",
+                             "judged on " + recs[richest].dir +
+                                 ", which moves the joints more",
+                             r.dir});
+        sections.push_back(k);
+      }
+      sections.push_back(bringup::compare_jacobian(r, shared, figs));
       if (r.verb == "hw motor-test") {
         bringup::ForceOptions fo;
         if (!o.scene.empty()) fo.scene = o.scene;
-        sections.push_back(bringup::compare_force_direction(r, maps[i], fo, figs));
+        sections.push_back(bringup::compare_force_direction(r, shared, fo, figs));
       }
       if (r.verb == "hw run") {
         sections.push_back(bringup::compare_force_mapping(r));
@@ -101,6 +162,12 @@ void compare(const CompareOptions& o) {
   } catch (const bringup::RecordingError& e) {
     throw UsageError(std::string("compare: ") + e.what());
   }
+
+  std::vector<bringup::SuspectedFault> all_faults;
+  for (const CompareSection& s : sections) {
+    all_faults.insert(all_faults.end(), s.faults.begin(), s.faults.end());
+  }
+  merge_delays(&all_faults);
 
   Json checks = Json::array(), skipped = Json::array(), evidence = Json::array();
   Json figures = Json::array(), detail = Json::array();
@@ -115,16 +182,17 @@ void compare(const CompareOptions& o) {
     for (const bringup::SkippedCheck& k : s.skipped) {
       skipped.push_back({{"name", k.name}, {"reason", k.reason}, {"recording", k.recording}});
     }
-    for (const bringup::SuspectedFault& f : s.faults) {
-      evidence.push_back({{"name", f.name}, {"evidence", f.evidence}, {"recording", f.recording}});
-      if (seen.insert(f.name).second) faults.push_back(f.name);
-    }
     for (const std::string& f : s.figures) figures.push_back(f);
     if (!s.detail.empty()) detail.push_back({{"section", s.name}, {"detail", s.detail}});
+  }
+  for (const bringup::SuspectedFault& f : all_faults) {
+    evidence.push_back({{"name", f.name}, {"evidence", f.evidence}, {"recording", f.recording}});
+    if (seen.insert(f.name).second) faults.push_back(f.name);
   }
   Json recordings = Json::array();
   for (const Recording& r : recs) {
     recordings.push_back({{"dir", r.dir}, {"verb", r.verb}, {"rows", r.rows},
+                          {"joint_excursion_rad", excitation[&r - recs.data()]},
                           {"reports_transform", r.has_transform()},
                           {"reports_jacobian", r.has_jacobian()}});
   }
