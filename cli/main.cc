@@ -4,7 +4,8 @@
 // Verbs: kin (kinematics of the Omni), ctl (one controller tick), run
 // (closed-loop simulation of the thesis cases), study (numerical studies),
 // params (the table of case parameters, docs/parameters.md), hw (a device,
-// real or emulated: docs/hardware.md).
+// real or emulated: docs/hardware.md), identify (the Omni model fitted to
+// recordings).
 //
 // Exit codes: 0 success, 2 bad usage or bad input (a device that cannot be
 // opened included), 1 any other failure, 128 + n when signal n (SIGINT,
@@ -21,6 +22,11 @@
 #include "cli/params.h"
 #include "cli/run.h"
 #include "cli/study.h"
+
+namespace vmh::cli {
+// cli/identify.cc: fit the Omni model to recordings
+void register_identify(CLI::App* app);
+}  // namespace vmh::cli
 
 namespace {
 
@@ -66,6 +72,7 @@ int main(int argc, char** argv) {
   vmh::cli::register_study(&app);
   vmh::cli::register_params(&app);
   vmh::cli::register_hw(&app);
+  vmh::cli::register_identify(&app);
 
   try {
     check_verbs(&app, argc, argv);

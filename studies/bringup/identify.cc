@@ -417,8 +417,18 @@ IdentifyResult identify(const std::vector<Recording>& recordings,
         cost = cn;
         lambda = std::max(lambda / 3.0, 1e-7);
         stepped = true;
-        // small in both the step and the improvement: done
-        if (dx.cwiseAbs().maxCoeff() < 1e-4 || gain < 1e-8) res.converged = true;
+        // done when the step is small against the parameters' own
+        // uncertainty (or the cost no longer moves): further digits mean
+        // nothing
+        const double rho = std::clamp(pb.lag1_correlation(r), 0.0, 0.99);
+        const Eigen::VectorXd sd_log =
+            (cost / static_cast<double>(N - P) * (1.0 + rho) / (1.0 - rho) *
+             A.completeOrthogonalDecomposition().pseudoInverse().diagonal())
+                .cwiseMax(0.0)
+                .cwiseSqrt();
+        if ((dx.cwiseAbs().array() <= 0.1 * sd_log.array() + 1e-6).all() || gain < 1e-9) {
+          res.converged = true;
+        }
       } else {
         lambda *= 4.0;
       }

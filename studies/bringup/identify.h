@@ -85,7 +85,8 @@ struct IdentifyOptions {
   bool find_signs = true;     // choose each pushed motor's sign first
   double before_s = 0.02;     // window start before a pulse starts
   double after_s = 0.2;       // window end after it ends
-  int max_iterations = 30;
+  // converged: every log-step within 0.1 sigma (widened as below)
+  int max_iterations = 60;
   int threads = 2;            // simulations in parallel
   // the scene for recordings whose meta.json names none
   // (meta["emulator"]["scene"]); empty: such recordings are an error
