@@ -5,7 +5,8 @@
 // (closed-loop simulation of the thesis cases), study (numerical studies),
 // params (the table of case parameters, docs/parameters.md), hw (a device,
 // real or emulated: docs/hardware.md), compare (device recordings against
-// the project's kinematics and the MJCF Omni: docs/bringup.md).
+// the project's kinematics and the MJCF Omni) and identify (the Omni model
+// fitted to recordings): docs/bringup.md.
 //
 // Exit codes: 0 success, 2 bad usage or bad input (a device that cannot be
 // opened included), 1 any other failure, 128 + n when signal n (SIGINT,
@@ -23,6 +24,11 @@
 #include "cli/params.h"
 #include "cli/run.h"
 #include "cli/study.h"
+
+namespace vmh::cli {
+// cli/identify.cc: fit the Omni model to recordings
+void register_identify(CLI::App* app);
+}  // namespace vmh::cli
 
 namespace {
 
@@ -69,6 +75,7 @@ int main(int argc, char** argv) {
   vmh::cli::register_params(&app);
   vmh::cli::register_hw(&app);
   vmh::cli::register_compare(&app);
+  vmh::cli::register_identify(&app);
 
   try {
     check_verbs(&app, argc, argv);

@@ -4,26 +4,52 @@
 #include <mutex>
 
 namespace vmh::sim {
+namespace {
 
-ModelPtr load_model(const std::string& path) {
+// the XML parser keeps global state (and mj_saveLastXML reads it): one
+// load, or load and save, at a time
+std::mutex& xml_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+// MuJoCo's messages span lines; the error contract is one line
+std::string one_line(const char* err, const char* fallback) {
+  std::string msg = err[0] ? err : fallback;
+  for (char& ch : msg) {
+    if (ch == '\n') ch = ' ';
+  }
+  return msg;
+}
+
+ModelPtr load_locked(const std::string& path) {
   // mj_loadXML's own message for a missing file is terse; say it plainly
   if (!std::ifstream(path).good()) {
     throw SimError(path + ": cannot open the scene file");
   }
-  // the XML parser keeps global state: one load at a time
-  static std::mutex load_mutex;
-  std::lock_guard<std::mutex> lock(load_mutex);
   char err[1024] = "";
   ModelPtr m(mj_loadXML(path.c_str(), nullptr, err, sizeof err));
-  if (!m) {
-    // MuJoCo's messages span lines; the error contract is one line
-    std::string msg = err[0] ? err : "MuJoCo could not load it";
-    for (char& ch : msg) {
-      if (ch == '\n') ch = ' ';
-    }
-    throw SimError(path + ": " + msg);
-  }
+  if (!m) throw SimError(path + ": " + one_line(err, "MuJoCo could not load it"));
   return m;
+}
+
+}  // namespace
+
+ModelPtr load_model(const std::string& path) {
+  std::lock_guard<std::mutex> lock(xml_mutex());
+  return load_locked(path);
+}
+
+void save_edited_model_xml(const std::string& in_path,
+                           const std::function<void(mjModel*)>& edit,
+                           const std::string& out_path) {
+  std::lock_guard<std::mutex> lock(xml_mutex());
+  ModelPtr m = load_locked(in_path);
+  if (edit) edit(m.get());
+  char err[1024] = "";
+  if (!mj_saveLastXML(out_path.c_str(), m.get(), err, sizeof err)) {
+    throw SimError(out_path + ": " + one_line(err, "MuJoCo could not save it"));
+  }
 }
 
 int require_id(const mjModel* m, mjtObj type, const char* name,

@@ -6,6 +6,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -32,6 +33,14 @@ using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 // Compiles an MJCF file. Throws SimError "<path>: <MuJoCo's message>" when the
 // file is missing or MuJoCo rejects it.
 ModelPtr load_model(const std::string& path);
+
+// Loads in_path, calls edit on the model, and writes it as MJCF to out_path
+// with mj_saveLastXML, which saves the last XML parsed with the model's
+// current values: so the load and the save hold load_model's lock together.
+// Throws SimError naming the file that could not be loaded or written.
+void save_edited_model_xml(const std::string& in_path,
+                           const std::function<void(mjModel*)>& edit,
+                           const std::string& out_path);
 
 // Id of a named object, or throws SimError "<what> '<name>' not found in
 // <source>".

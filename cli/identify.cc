@@ -1,0 +1,229 @@
+// vmhaptics identify <recording-dir>... [--out DIR] [--model-out FILE]
+//                    [--fit mass,friction,damping,gains] [--serial S]
+//
+// Fits the MJCF Omni's uncertain scales to recordings' motor pulses
+// (studies/bringup/identify.h says how, and what cannot be identified),
+// writes the calibrated model (default
+// <models>/omni/calibrated/<serial>.xml) and, with --out, DIR/identify.json
+// and DIR/identify_fit.svg. Prints one JSON object.
+//
+// Exit codes: 0 a converged, well-conditioned fit; 1 the fit did not
+// converge or is poorly conditioned (the JSON says which, and is still
+// printed and written); 2 bad input (a missing directory, not a
+// recording, no motor pulse in any, an unknown --fit name).
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cli/args.h"
+#include "cli/json_util.h"
+#include "report/output_file.h"
+#include "report/svg_chart.h"
+#include "studies/bringup/identify.h"
+#include "studies/bringup/recording.h"
+#include "studies/run_case.h"
+
+namespace vmh::cli {
+namespace {
+
+struct IdentifyCliOptions {
+  std::vector<std::string> dirs;
+  std::string out;
+  std::string model_out;
+  std::string fit = "mass,friction,damping";
+  std::string serial;
+};
+
+std::vector<std::string> split_names(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream s(text);
+  for (std::string item; std::getline(s, item, ',');) {
+    if (item.empty()) throw UsageError("identify: --fit has an empty name in '" + text + "'");
+    if (item != "mass" && item != "friction" && item != "damping" && item != "gains") {
+      throw UsageError("identify: --fit: unknown parameter '" + item +
+                       "' (expected mass, friction, damping, gains)");
+    }
+    out.push_back(item);
+  }
+  if (out.empty()) throw UsageError("identify: --fit names nothing to fit");
+  return out;
+}
+
+std::string serial_of(const std::vector<bringup::Recording>& recs) {
+  for (const bringup::Recording& r : recs) {
+    const auto& m = r.meta;
+    if (m.contains("device") && m["device"].is_object() &&
+        m["device"].contains("serial") && m["device"]["serial"].is_string()) {
+      return m["device"]["serial"].get<std::string>();
+    }
+  }
+  return "unknown";
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+// measured, nominal and fitted response of each window's pushed joint
+std::string fit_figure(const bringup::IdentifyResult& r) {
+  report::ChartGrid grid;
+  grid.title = "identify: pushed joint, measured vs simulated before and after the fit";
+  grid.notes.push_back("device angles t1..t3 (rad); nominal = the model as written");
+  grid.notes.push_back("fitted: " + sim::omni_edit_text(r.edit));
+  grid.columns = 3;
+  for (const bringup::WindowTrace& w : r.traces) {
+    report::Chart c;
+    c.title = std::filesystem::path(r.recordings[w.recording].dir).filename().string() +
+              ", motor " + std::to_string(w.motor);
+    c.x.label = "time from window start (s)";
+    c.y.label = "t" + std::to_string(w.motor) + " (rad, device)";
+    std::vector<double> t;
+    for (double ts : w.t_s) t.push_back(ts - w.t_s.front());
+    c.series.push_back({"measured", t, w.measured_rad, "#222222", false, true, false});
+    c.series.push_back({"nominal", t, w.before_rad, "#d62728", true, false, true});
+    c.series.push_back({"fitted", t, w.after_rad, "#1f77b4", true, false, false});
+    c.width_px = 420;
+    c.height_px = 300;
+    grid.panels.push_back(std::move(c));
+  }
+  return report::chart_grid_svg(grid);
+}
+
+Json result_json(const bringup::IdentifyResult& r, const std::vector<std::string>& fit) {
+  Json out;
+  out["fit"] = fit;
+  Json params = Json::array();
+  for (const bringup::FittedParameter& p : r.parameters) {
+    params.push_back({{"name", p.name}, {"unit", p.unit}, {"nominal", p.nominal},
+                      {"fitted", p.fitted}, {"sigma", p.sigma},
+                      {"identified", p.identified}});
+  }
+  out["parameters"] = params;
+  Json signs = Json::array();
+  for (const bringup::MotorSign& s : r.signs) {
+    signs.push_back({{"motor", s.motor}, {"sign", s.sign},
+                     {"agreement", s.agreement}, {"determined", s.determined}});
+  }
+  out["motor_signs"] = signs;
+  out["edit"] = sim::omni_edit_text(r.edit);
+  out["correlation"] = to_json_rows(r.correlation);
+  out["condition_number"] = r.condition_number;
+  out["poorly_conditioned"] = r.poorly_conditioned;
+  out["conditioning"] = r.conditioning;
+  out["converged"] = r.converged;
+  out["iterations"] = r.iterations;
+  out["residuals"] = r.residuals;
+  // weighted sums of squares per residual (1 = quantization noise)
+  out["cost_before"] = r.cost_before;
+  out["cost_after"] = r.cost_after;
+  out["residual_lag1_correlation"] = r.residual_lag1_correlation;
+  out["sigma_inflation"] = r.sigma_inflation;
+  Json recs = Json::array();
+  for (const bringup::RecordingFit& f : r.recordings) {
+    recs.push_back({{"dir", f.dir}, {"windows", f.windows}, {"samples", f.samples},
+                    {"rms_before_rad", f.rms_before_rad}, {"rms_after_rad", f.rms_after_rad},
+                    {"rms_before_mm", f.rms_before_mm}, {"rms_after_mm", f.rms_after_mm}});
+  }
+  out["recordings"] = recs;
+  out["notes"] = r.notes;
+  return out;
+}
+
+void identify_verb(const IdentifyCliOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  bringup::IdentifyOptions io;
+  io.fit = split_names(o.fit);
+  // a real device's recording names no scene: the emulator's default one
+  io.default_scene = studies::models_dir() + "/cases/case1.xml";
+  std::vector<bringup::Recording> recs;
+  for (const std::string& d : o.dirs) {
+    if (!std::filesystem::is_directory(d)) {
+      throw UsageError("identify: " + d + " is not a directory");
+    }
+    try {
+      recs.push_back(bringup::load_recording(d));
+    } catch (const bringup::RecordingError& e) {
+      throw UsageError(std::string("identify: not a recording: ") + e.what());
+    }
+  }
+  bringup::IdentifyResult r;
+  try {
+    r = bringup::identify(recs, io);
+  } catch (const bringup::IdentifyError& e) {
+    throw UsageError(e.what());
+  }
+
+  const std::string serial = o.serial.empty() ? serial_of(recs) : o.serial;
+  const std::string model = o.model_out.empty()
+                                ? studies::models_dir() + "/omni/calibrated/" + serial + ".xml"
+                                : o.model_out;
+  std::ostringstream prov;
+  prov << "calibrated by vmhaptics identify: serial " << serial << ", " << utc_now()
+       << "; recordings";
+  for (const bringup::RecordingFit& f : r.recordings) prov << ' ' << f.dir;
+  prov << "; fitted";
+  for (const bringup::FittedParameter& p : r.parameters) {
+    prov << ' ' << p.name << '=' << p.fitted << "+-" << p.sigma
+         << (p.identified ? "" : " (not identified)");
+  }
+  prov << "; edit " << sim::omni_edit_text(r.edit) << "; " << r.conditioning;
+  const std::filesystem::path model_dir = std::filesystem::path(model).parent_path();
+  if (!model_dir.empty()) std::filesystem::create_directories(model_dir);
+  bringup::write_calibrated_model(r.edit, studies::models_dir() + "/omni/omni.xml", model, prov.str());
+
+  Json out;
+  out["serial"] = serial;
+  out.update(result_json(r, io.fit));
+  out["model"] = model;
+  Json outputs = Json::array({model});
+  if (!o.out.empty()) {
+    outputs.push_back(o.out + "/identify.json");
+    outputs.push_back(o.out + "/identify_fit.svg");
+  }
+  out["outputs"] = outputs;
+  out["run_time_s"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!o.out.empty()) {
+    report::write_file_in(o.out, "identify_fit.svg", fit_figure(r));
+    report::write_file_in(o.out, "identify.json", dump_readable(out) + "\n");
+  }
+  std::cout << dump_readable(out) << '\n';
+  if (!r.converged) {
+    throw std::runtime_error("identify: the fit did not converge in " +
+                             std::to_string(r.iterations) + " iterations");
+  }
+  if (r.poorly_conditioned) throw std::runtime_error("identify: " + r.conditioning);
+}
+
+}  // namespace
+
+void register_identify(CLI::App* app) {
+  auto o = std::make_shared<IdentifyCliOptions>();
+  CLI::App* c = app->add_subcommand(
+      "identify",
+      "fit the Omni model's mass, friction, damping (and motor gains) to "
+      "motor-test recordings; write a calibrated model");
+  c->add_option("dirs", o->dirs, "recording directories (meta.json, trace.csv)")
+      ->required();
+  c->add_option("--out", o->out, "write DIR/identify.json and DIR/identify_fit.svg");
+  c->add_option("--model-out", o->model_out,
+                "calibrated model path (default <models>/omni/calibrated/<serial>.xml)");
+  c->add_option("--fit", o->fit,
+                "scales to fit: mass,friction,damping,gains (default mass,friction,damping)");
+  c->add_option("--serial", o->serial, "device serial (default: the recordings' meta.json)");
+  c->callback([o]() { identify_verb(*o); });
+}
+
+}  // namespace vmh::cli
