@@ -166,7 +166,9 @@ void hw_run(const HwRunOptions& o) {
   if (!o.out.empty()) {
     report::write_file_in(o.out, "summary.json", dump_readable(summary) + "\n");
   }
-  write_meta(o.out, meta_json(dev, r, "run", Json{{"case", name}, {"scene", scene}}));
+  write_meta(o.out, meta_json(dev, r, "run",
+                              Json{{"case", name}, {"scene", scene}, {"sets", o.sets},
+                                   {"gain_scale", o.gain_scale}}));
   std::cout << dump_readable(summary) << '\n';
   raise_if_cut_short(r, "run");
   if (!claims_pass) {
