@@ -53,7 +53,7 @@ TEST(BringupDoc, StepsComeInTheProceduresOrder) {
        {"vmhaptics hw list", "vmhaptics hw probe", "vmhaptics hw calibrate",
         "vmhaptics hw record", "vmhaptics compare bringup/record ",
         "vmhaptics hw motor-test", "vmhaptics compare bringup/record bringup/motor1",
-        "vmhaptics identify", "--gain-scale 0.2", "vmhaptics hw run case1 --device \"$DEVICE\" --duration"}) {
+        "vmhaptics identify", "--gain-scale 0.2", "vmhaptics hw run case1 --device \"$DEVICE\" --out bringup/run-full"}) {
     const std::size_t next = all.find(step, at);
     ASSERT_NE(next, std::string::npos) << "step missing or out of order: " << step;
     at = next;
