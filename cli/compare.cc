@@ -232,7 +232,7 @@ void register_compare(CLI::App* app) {
   cmd->add_option("--out", o->out, "write DIR/compare.json and the figures");
   cmd->add_option("--scene", o->scene,
                   "the scene to predict a motor test with when the recording "
-                  "does not name one (default models/omni/scene.xml)");
+                  "does not name one (default models/cases/case1.xml, the emulator's)");
   cmd->callback([o]() { compare(*o); });
 }
 

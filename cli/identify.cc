@@ -13,7 +13,6 @@
 // recording, no motor pulse in any, an unknown --fit name).
 #include <CLI/CLI.hpp>
 #include <chrono>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -23,6 +22,7 @@
 #include <vector>
 
 #include "cli/args.h"
+#include "cli/hw_common.h"
 #include "cli/json_util.h"
 #include "report/output_file.h"
 #include "report/svg_chart.h"
@@ -65,15 +65,6 @@ std::string serial_of(const std::vector<bringup::Recording>& recs) {
     }
   }
   return "unknown";
-}
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
 }
 
 // measured, nominal and fitted response of each window's pushed joint

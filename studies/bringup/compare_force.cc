@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "controller/device_frame.h"
+#include "controller/omni_params.h"
 #include "report/output_file.h"
 #include "report/svg_chart.h"
 #include "studies/bringup/response_sim.h"
@@ -196,7 +197,7 @@ double rms_error(const PulseWindow& w, const SimulatedResponse& pred) {
 }
 
 // ten encoder counts (2 pi / 15000 rad each on t1..t3)
-constexpr double kWindowEffect_rad = 10.0 * 2.0 * kPi / 15000.0;
+const double kWindowEffect_rad = 10.0 * 2.0 * kPi / OmniParams().encoder_counts_per_rev;
 
 // the end of the angle and gain's window: t1_s, or later (up to the
 // window's end) until the predicted effect reaches kWindowEffect_rad
@@ -228,7 +229,7 @@ struct Fit {
 
 // below this the predicted effect is lost in the encoders' quantization
 // (2 pi / 15000 rad a count on t1..t3): a few counts' worth
-constexpr double kMinEffect_rad = 3.0 * 2.0 * kPi / 15000.0;
+const double kMinEffect_rad = 3.0 * 2.0 * kPi / OmniParams().encoder_counts_per_rev;
 
 Fit fit(const std::vector<double>& m, const std::vector<double>& p) {
   Fit f;
@@ -355,13 +356,10 @@ CompareSection compare_force_direction(const Recording& rec,
     return s;
   }
   const std::string prefix = "force_direction.motor" + std::to_string(w.motor);
-  std::string scene =
-      o.scene.empty() ? studies::models_dir() + "/cases/case1.xml" : o.scene;
   // the emulator's own scene when it says which (never its seeded faults)
-  if (rec.meta.contains("emulator") && rec.meta["emulator"].is_object() &&
-      rec.meta["emulator"].contains("scene") &&
-      rec.meta["emulator"]["scene"].is_string()) {
-    scene = rec.meta["emulator"]["scene"].get<std::string>();
+  std::string scene = rec.emulator_scene();
+  if (scene.empty()) {
+    scene = o.scene.empty() ? studies::models_dir() + "/cases/case1.xml" : o.scene;
   }
   ResponseSimulator sim(scene, o.model_file);
   const ResponseInput in = response_input(w, o);

@@ -94,11 +94,8 @@ double scale_of(const Param& p, const sim::OmniModelEdit& e) {
 }
 
 std::string scene_of(const Recording& r, const IdentifyOptions& o) {
-  const auto& meta = r.meta;
-  if (meta.contains("emulator") && meta["emulator"].is_object() &&
-      meta["emulator"].contains("scene") && meta["emulator"]["scene"].is_string()) {
-    return meta["emulator"]["scene"].get<std::string>();
-  }
+  std::string scene = r.emulator_scene();
+  if (!scene.empty()) return scene;
   if (o.default_scene.empty()) {
     throw IdentifyError("identify: recording " + r.dir +
                         " names no scene (meta.json emulator.scene) and no "

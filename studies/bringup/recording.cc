@@ -55,6 +55,14 @@ std::vector<std::size_t> Recording::good_rows() const {
   return out;
 }
 
+std::string Recording::emulator_scene() const {
+  if (meta.contains("emulator") && meta["emulator"].is_object() &&
+      meta["emulator"].contains("scene") && meta["emulator"]["scene"].is_string()) {
+    return meta["emulator"]["scene"].get<std::string>();
+  }
+  return {};
+}
+
 Vec3 Recording::vec3(const std::string& prefix, const std::string& suffix,
                      std::size_t row, bool xyz) const {
   static const char* kXyz[] = {"x", "y", "z"};

@@ -56,6 +56,10 @@ struct Recording {
   // the emulator's ground truth is in the trace (tau_applied_*, hand_*)
   bool has_truth() const { return has("tau_applied_1_Nm"); }
 
+  // the scene the emulator simulated (meta.json emulator.scene), empty for
+  // a device: what compare and identify predict with
+  std::string emulator_scene() const;
+
   double t_s(std::size_t row) const { return col("t_s")[row]; }
   Joints q_dh_rad(std::size_t row) const;   // q1..q6, DH (q3 relative)
   Vec3 p_mm(std::size_t row) const;          // project FK, device frame

@@ -20,16 +20,11 @@
 #ifndef VMHAPTICS_STUDIES_BRINGUP_RESPONSE_SIM_H_
 #define VMHAPTICS_STUDIES_BRINGUP_RESPONSE_SIM_H_
 
-#include <memory>
 #include <string>
 #include <vector>
 
 #include "controller/types.h"
 #include "sim/omni_model_edit.h"
-
-namespace vmh::sim {
-class ClosedLoop;
-}
 
 namespace vmh::bringup {
 

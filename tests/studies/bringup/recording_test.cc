@@ -44,6 +44,15 @@ TEST(Recording, ReadsNumbersTextAndNaN) {
   EXPECT_FALSE(r.has_jacobian());
   EXPECT_DOUBLE_EQ(r.dev_p_mm(2).x(), 1.5);
   EXPECT_DOUBLE_EQ(r.tau_sent_Nm(2)[2], 0.02);
+  EXPECT_EQ(r.emulator_scene(), "");  // a device names no scene
+}
+
+TEST(Recording, TheEmulatorsSceneComesFromMeta) {
+  const fs::path d = make_dir("emu");
+  write(d / "meta.json", R"({"verb": "hw motor-test", "emulator": {"scene": "/m/case2.xml"}})");
+  write(d / "trace.csv", std::string(kHeader) +
+                             "0,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n");
+  EXPECT_EQ(load_recording(d.string()).emulator_scene(), "/m/case2.xml");
 }
 
 TEST(Recording, ALastRowCutShortIsDropped) {
