@@ -1,0 +1,192 @@
+#include "viz/overlay.h"
+
+#include <cmath>
+
+#include "controller/device_frame.h"
+
+namespace vmh::viz {
+namespace {
+
+constexpr std::array<float, 4> kPathRgba{0.45f, 0.65f, 0.95f, 0.9f};
+constexpr std::array<float, 4> kVRgba{0.90f, 0.15f, 0.15f, 1.0f};
+constexpr std::array<float, 4> kRRgba{0.15f, 0.75f, 0.20f, 1.0f};
+constexpr std::array<float, 4> kStylusRgba{0.95f, 0.85f, 0.10f, 1.0f};
+constexpr std::array<float, 4> kForceRgba{0.85f, 0.10f, 0.85f, 1.0f};
+
+// a point in the controller's length unit, device frame -> world m
+struct ToWorld {
+  const OmniParams& omni;
+  double unit_mm;
+  Vec3 point(const Vec3& p_lu) const {
+    return device_mm_to_base(omni, p_lu * unit_mm);
+  }
+  Vec3 point_mm(const Vec3& p_mm) const {
+    return device_mm_to_base(omni, p_mm);
+  }
+};
+
+OverlayPrimitive segment(OverlayId id, const Vec3& a, const Vec3& b,
+                         double r, const std::array<float, 4>& rgba) {
+  OverlayPrimitive p;
+  p.shape = OverlayPrimitive::Shape::kSegment;
+  p.id = id;
+  p.a_m = a;
+  p.b_m = b;
+  p.radius_m = r;
+  p.rgba = rgba;
+  return p;
+}
+
+// a circle of radius r (length unit) about `centre` in the plane spanned by
+// the unit vectors u, v (device frame), as n segments in world metres
+void add_circle(const ToWorld& w, const Vec3& centre, const Vec3& u,
+                const Vec3& v, double r, const OverlayOptions& opt,
+                std::vector<OverlayPrimitive>* prims) {
+  const int n = opt.circle_segments < 8 ? 8 : opt.circle_segments;
+  Vec3 prev = w.point(centre + r * u);
+  for (int i = 1; i <= n; ++i) {
+    const double a = 2.0 * M_PI * i / n;
+    const Vec3 next =
+        w.point(centre + r * (std::cos(a) * u + std::sin(a) * v));
+    prims->push_back(
+        segment(OverlayId::kPath, prev, next, opt.line_radius_m, kPathRgba));
+    prev = next;
+  }
+}
+
+void add_path(const VirtualMechanism& vm, const ToWorld& w,
+              const ControlOutput& out, const OverlayOptions& opt,
+              std::vector<OverlayPrimitive>* prims) {
+  const VmMount& m = vm.mount();
+  const Vec3 x = m.R.col(0), y = m.R.col(1), z = m.R.col(2);
+  switch (vm.kind()) {
+    case VmKind::kCircle:
+      add_circle(w, m.origin, x, y, vm.length(), opt, prims);
+      break;
+    case VmKind::kSphere:
+      add_circle(w, m.origin, x, y, vm.length(), opt, prims);
+      add_circle(w, m.origin, x, z, vm.length(), opt, prims);
+      add_circle(w, m.origin, y, z, vm.length(), opt, prims);
+      break;
+    case VmKind::kSurface: {
+      // the plane the tip slides on, a square grid centred under X(theta_V)
+      const Vec3 xv_lu = out.x_v_mm / w.unit_mm;
+      Vec3 r = m.R.transpose() * (xv_lu - m.origin);
+      r.z() = 0.0;
+      const Vec3 c = m.origin + m.R * r;
+      const double h = opt.surface_half_width_m * 1000.0 / w.unit_mm;
+      const int n = opt.surface_lines < 2 ? 2 : opt.surface_lines;
+      for (int i = 0; i < n; ++i) {
+        const double s = -h + 2.0 * h * i / (n - 1);
+        prims->push_back(segment(OverlayId::kPath,
+                                 w.point(c + s * x - h * y),
+                                 w.point(c + s * x + h * y),
+                                 opt.line_radius_m, kPathRgba));
+        prims->push_back(segment(OverlayId::kPath,
+                                 w.point(c - h * x + s * y),
+                                 w.point(c + h * x + s * y),
+                                 opt.line_radius_m, kPathRgba));
+      }
+      break;
+    }
+  }
+}
+
+// the link of the VM at theta: from its pivot (the surface: its tip) to the
+// handle, which is L back along the link's axis
+void add_link(const VirtualMechanism& vm, const ToWorld& w,
+              const VmAngles& theta, OverlayId link, OverlayId point,
+              const std::array<float, 4>& rgba, const OverlayOptions& opt,
+              std::vector<OverlayPrimitive>* prims) {
+  if (theta.size() != vm.dof() || !theta.allFinite()) return;
+  const VmPose pose = vm.pose(theta);
+  const Vec3 handle = w.point(pose.p);
+  const Vec3 root = w.point(pose.p - vm.length() * pose.axis);
+  prims->push_back(segment(link, root, handle, 2.0 * opt.line_radius_m,
+                           rgba));
+  OverlayPrimitive s;
+  s.shape = OverlayPrimitive::Shape::kSphere;
+  s.id = point;
+  s.a_m = s.b_m = handle;
+  s.radius_m = opt.point_radius_m;
+  s.rgba = rgba;
+  prims->push_back(s);
+}
+
+}  // namespace
+
+const char* overlay_name(OverlayId id) {
+  switch (id) {
+    case OverlayId::kPath: return "path";
+    case OverlayId::kLinkV: return "link_v";
+    case OverlayId::kLinkR: return "link_r";
+    case OverlayId::kPointV: return "x_v";
+    case OverlayId::kPointR: return "x_r";
+    case OverlayId::kStylus: return "stylus";
+    case OverlayId::kForce: return "force";
+  }
+  return "?";
+}
+
+void overlay_primitives(const VirtualMechanism& vm,
+                        const ControllerParams& params,
+                        const ControlOutput& out, const OverlayOptions& opt,
+                        std::vector<OverlayPrimitive>* prims) {
+  prims->clear();
+  const ToWorld w{params.omni, params.length_unit_mm};
+  if (opt.path) add_path(vm, w, out, opt, prims);
+  if (opt.mechanism) {
+    add_link(vm, w, out.theta_v, OverlayId::kLinkV, OverlayId::kPointV, kVRgba,
+             opt, prims);
+    add_link(vm, w, out.theta_r, OverlayId::kLinkR, OverlayId::kPointR, kRRgba,
+             opt, prims);
+  }
+  const Vec3 p = w.point_mm(out.p_rm_mm);
+  if (opt.stylus && out.axis_rm.allFinite() && p.allFinite()) {
+    const Vec3 a = device_to_base_vector(out.axis_rm).normalized();
+    const double h = 0.5 * opt.stylus_length_m;
+    prims->push_back(segment(OverlayId::kStylus, p - h * a, p + h * a,
+                             1.5 * opt.line_radius_m, kStylusRgba));
+  }
+  const double f = out.force_device_N.norm();
+  if (opt.force && std::isfinite(f) && f >= opt.min_force_N && p.allFinite()) {
+    const Vec3 dir = device_to_base_vector(out.force_device_N) / f;
+    OverlayPrimitive arrow =
+        segment(OverlayId::kForce, p, p + opt.force_m_per_N * f * dir,
+                2.5 * opt.line_radius_m, kForceRgba);
+    arrow.shape = OverlayPrimitive::Shape::kArrow;
+    prims->push_back(arrow);
+  }
+}
+
+int add_overlay_to_scene(const std::vector<OverlayPrimitive>& prims,
+                         mjvScene* scn) {
+  int added = 0;
+  for (const OverlayPrimitive& p : prims) {
+    if (scn->ngeom >= scn->maxgeom) break;
+    mjvGeom* g = scn->geoms + scn->ngeom;
+    const float* rgba = p.rgba.data();
+    if (p.shape == OverlayPrimitive::Shape::kSphere) {
+      const mjtNum size[3] = {p.radius_m, p.radius_m, p.radius_m};
+      const mjtNum pos[3] = {p.a_m.x(), p.a_m.y(), p.a_m.z()};
+      mjv_initGeom(g, mjGEOM_SPHERE, size, pos, nullptr, rgba);
+    } else {
+      // MuJoCo cannot orient a connector of zero length
+      if ((p.b_m - p.a_m).norm() < 1e-9) continue;
+      mjv_initGeom(g, mjGEOM_NONE, nullptr, nullptr, nullptr, rgba);
+      const int type = p.shape == OverlayPrimitive::Shape::kArrow
+                           ? mjGEOM_ARROW
+                           : mjGEOM_CAPSULE;
+      mjv_makeConnector(g, type, p.radius_m, p.a_m.x(), p.a_m.y(), p.a_m.z(),
+                        p.b_m.x(), p.b_m.y(), p.b_m.z());
+    }
+    g->category = mjCAT_DECOR;
+    g->objtype = mjOBJ_UNKNOWN;
+    g->objid = -1;
+    scn->ngeom++;
+    ++added;
+  }
+  return added;
+}
+
+}  // namespace vmh::viz
