@@ -8,12 +8,12 @@
 // Exit codes: 0 written; 2 bad usage or bad input (nothing is written);
 // 1 anything else, no OpenGL context included.
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <iostream>
 
 #include "cli/args.h"
+#include "cli/json_util.h"
 #include "sim/mujoco_util.h"
 #include "studies/run_case.h"
 #include "viz/render.h"
@@ -85,22 +85,24 @@ void render_verb(const RenderOptions& o) {
     throw UsageError(std::string("render ") + req.name + ": " + e.what());
   }
 
-  nlohmann::json j;
+  Json j;
   j["scene"] = req.scene_path;
   j["case"] = req.name;
   j["width_px"] = req.width_px;
   j["height_px"] = req.height_px;
   j["camera"] = req.camera.empty() ? "default" : req.camera;
   j["overlay"] = req.overlays;
-  j["images"] = nlohmann::json::array();
+  j["images"] = Json::array();
   for (const viz::RenderedImage& img : images) {
-    j["images"].push_back({{"t_s", img.t_s},
-                           {"sim_t_s", img.sim_t_s},
-                           {"path", img.path},
-                           {"force_N", img.force_N},
-                           {"d_path_mm", img.d_path_mm}});
+    Json im;
+    im["t_s"] = img.t_s;
+    im["sim_t_s"] = img.sim_t_s;
+    im["path"] = img.path;
+    im["force_N"] = img.force_N;
+    im["d_path_mm"] = img.d_path_mm;
+    j["images"].push_back(std::move(im));
   }
-  std::cout << j.dump(2) << '\n';
+  std::cout << dump_readable(j) << '\n';
 }
 
 }  // namespace
