@@ -6,7 +6,8 @@
 // params (the table of case parameters, docs/parameters.md), hw (a device,
 // real or emulated: docs/hardware.md), compare (device recordings against
 // the project's kinematics and the MJCF Omni) and identify (the Omni model
-// fitted to recordings): docs/bringup.md.
+// fitted to recordings): docs/bringup.md; render (PNG images of a case at
+// given times, when built with the viz library).
 //
 // Exit codes: 0 success, 2 bad usage or bad input (a device that cannot be
 // opened included), 1 any other failure, 128 + n when signal n (SIGINT,
@@ -28,6 +29,10 @@
 namespace vmh::cli {
 // cli/identify.cc: fit the Omni model to recordings
 void register_identify(CLI::App* app);
+#ifdef VMH_HAVE_VIZ
+// cli/render.cc: headless PNG renders of a case
+void register_render(CLI::App* app);
+#endif
 }  // namespace vmh::cli
 
 namespace {
@@ -76,6 +81,9 @@ int main(int argc, char** argv) {
   vmh::cli::register_hw(&app);
   vmh::cli::register_compare(&app);
   vmh::cli::register_identify(&app);
+#ifdef VMH_HAVE_VIZ
+  vmh::cli::register_render(&app);
+#endif
 
   try {
     check_verbs(&app, argc, argv);

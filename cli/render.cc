@@ -1,0 +1,154 @@
+// vmhaptics render <case|scene.xml> --t s1,s2,... --out DIR
+//                   [--width W --height H --camera NAME] [--set name=value]
+//                   [--no-overlay] [--no-label] [--model FILE]
+//
+// Runs the case headless and writes one PNG per time (viz/render.h), then
+// prints one JSON object naming them (docs/outputs.md, "render"). Needs an
+// OpenGL context: a display, or Xvfb (`xvfb-run -a vmhaptics render ...`).
+// Exit codes: 0 written; 2 bad usage or bad input (nothing is written);
+// 1 anything else, no OpenGL context included.
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <iostream>
+
+#include "cli/args.h"
+#include "cli/json_util.h"
+#include "sim/mujoco_util.h"
+#include "studies/run_case.h"
+#include "viz/render.h"
+
+namespace vmh::cli {
+namespace {
+
+struct RenderOptions {
+  std::string target;
+  std::string times;
+  std::string out;
+  int width_px = 640;
+  int height_px = 480;
+  std::string camera;
+  std::vector<std::string> sets;
+  bool no_overlay = false;
+  bool no_label = false;
+  std::string model;
+};
+
+std::vector<double> parse_times(const std::string& text) {
+  std::vector<double> times;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item = text.substr(
+        start, comma == std::string::npos ? std::string::npos : comma - start);
+    const double t = parse_number("--t", item);
+    if (t < 0.0) {
+      throw UsageError("--t: time '" + item + "' is negative (want s >= 0)");
+    }
+    times.push_back(t);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return times;
+}
+
+void render_verb(const RenderOptions& o) {
+  viz::RenderRequest req;
+  req.times_s = parse_times(o.times);
+  try {
+    req.scene_path = studies::resolve_scene(o.target, &req.name);
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("render: ") + e.what());
+  }
+  if (!o.model.empty()) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(o.model, ec)) {
+      throw UsageError("--model: no such file '" + o.model + "'");
+    }
+    req.model_hook = sim::omni_model_hook(
+        std::filesystem::absolute(o.model, ec).string());
+  }
+  req.overrides = o.sets;
+  req.width_px = o.width_px;
+  req.height_px = o.height_px;
+  req.camera = o.camera;
+  req.overlays = !o.no_overlay;
+  req.label = !o.no_label;
+  req.out_dir = o.out;
+
+  std::vector<viz::RenderedImage> images;
+  try {
+    images = viz::render(req);
+  } catch (const viz::RenderInputError& e) {
+    throw UsageError(e.what());
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("render ") + req.name + ": " + e.what());
+  }
+
+  Json j;
+  j["scene"] = req.scene_path;
+  j["case"] = req.name;
+  j["width_px"] = req.width_px;
+  j["height_px"] = req.height_px;
+  j["camera"] = req.camera.empty() ? "default" : req.camera;
+  j["overlay"] = req.overlays;
+  j["images"] = Json::array();
+  for (const viz::RenderedImage& img : images) {
+    Json im;
+    im["t_s"] = img.t_s;
+    im["sim_t_s"] = img.sim_t_s;
+    im["path"] = img.path;
+    im["force_N"] = img.force_N;
+    im["d_path_mm"] = img.d_path_mm;
+    j["images"].push_back(std::move(im));
+  }
+  std::cout << dump_readable(j) << '\n';
+}
+
+}  // namespace
+
+void register_render(CLI::App* app) {
+  auto o = std::make_shared<RenderOptions>();
+  CLI::App* cmd = app->add_subcommand(
+      "render",
+      "headless PNG renders of a thesis case (case1..case6) or a scene file "
+      "at given simulated times: the MuJoCo Omni held by the simulated hand, "
+      "with the virtual mechanism, the stylus axis and the commanded force "
+      "drawn over it; needs a display or Xvfb (xvfb-run -a vmhaptics "
+      "render ...); prints one JSON object naming the files");
+  cmd->add_option("target", o->target,
+                  "case1..case6, or the path of a scene .xml")
+      ->required();
+  cmd->add_option("--t", o->times,
+                  "simulated times in s, comma-separated (e.g. 0.5,1,2.5); "
+                  "each >= 0, and past the run's duration the hand holds "
+                  "its last target; each image shows the first servo tick "
+                  "ending at or after its time")
+      ->required();
+  cmd->add_option("--out", o->out,
+                  "folder for the images, created if needed: "
+                  "DIR/<case>_t<time in ms, 6 digits>ms.png")
+      ->required();
+  cmd->add_option("--width", o->width_px,
+                  "image width in px, 16..4096 (default 640)");
+  cmd->add_option("--height", o->height_px,
+                  "image height in px, 16..4096 (default 480)");
+  cmd->add_option("--camera", o->camera,
+                  "a camera of the model, by name (default: a free camera "
+                  "framing the arm and the VM's path from the user's side)");
+  cmd->add_option("--set", o->sets,
+                  "override a case parameter, name=value, as for run; "
+                  "repeatable")
+      ->allow_extra_args(false);
+  cmd->add_flag("--no-overlay", o->no_overlay,
+                "the MuJoCo scene only: no VM path, links, stylus axis or "
+                "force arrow");
+  cmd->add_flag("--no-label", o->no_label,
+                "no text label (case, t, |F|, distance to the path)");
+  cmd->add_option("--model", o->model,
+                  "a calibrated Omni MJCF whose parameters replace the "
+                  "scene's Omni's, as for run");
+  cmd->callback([o] { render_verb(*o); });
+}
+
+}  // namespace vmh::cli
