@@ -28,6 +28,10 @@
 namespace vmh::cli {
 // cli/identify.cc: fit the Omni model to recordings
 void register_identify(CLI::App* app);
+#ifdef VMH_HAVE_VIZ
+// cli/view.cc: the interactive viewer
+void register_view(CLI::App* app);
+#endif
 }  // namespace vmh::cli
 
 namespace {
@@ -76,6 +80,9 @@ int main(int argc, char** argv) {
   vmh::cli::register_hw(&app);
   vmh::cli::register_compare(&app);
   vmh::cli::register_identify(&app);
+#ifdef VMH_HAVE_VIZ
+  vmh::cli::register_view(&app);
+#endif
 
   try {
     check_verbs(&app, argc, argv);

@@ -52,8 +52,14 @@ Viewer::Viewer(const ViewerOptions& options)
   plots_ = std::make_unique<std::array<PlotSample, kPlotSamples>>();
   build_case();
   mjv_defaultFreeCamera(model(), &cam_);
-  // closer than MuJoCo's default: the Omni is small in its scene
-  cam_.distance *= 0.6;
+  // looking at the VM's path, from far enough to see the arm that holds
+  // the stylus on it
+  const ControllerParams& p = overlay_controller_->params();
+  const Vec3 pivot_m = device_mm_to_base(p.omni, p.vm.pivot_mm);
+  for (int i = 0; i < 3; ++i) cam_.lookat[i] = pivot_m[i];
+  cam_.distance = 0.45;
+  cam_.azimuth = 150.0;
+  cam_.elevation = -25.0;
 }
 
 Viewer::~Viewer() {
@@ -244,6 +250,9 @@ bool Viewer::frame() {
 
 long Viewer::run() {
   while (opt_.max_frames <= 0 || frames_ < opt_.max_frames) {
+    if (opt_.screenshot_last_frame && frames_ + 1 == opt_.max_frames) {
+      want_shot_ = true;
+    }
     if (!frame()) break;
   }
   return frames_;

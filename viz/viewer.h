@@ -61,6 +61,7 @@ struct ViewerOptions {
   int max_frames = 0;             // > 0: run() returns after this many
   std::string out_dir = ".";      // screenshots
   bool start_with_mouse_hand = false;
+  bool screenshot_last_frame = false;  // with max_frames: the last one
   // a live device instead of the physics thread (--device); called once a
   // frame from the render thread; must not block
   std::function<LiveSample()> live;

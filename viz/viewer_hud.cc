@@ -1,5 +1,6 @@
 #include "viz/viewer_hud.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 
@@ -18,7 +19,7 @@ void setup_figure(mjvFigure* f, const char* title, const float rgb[3]) {
   f->gridsize[1] = 4;
   f->figurergba[3] = 0.6f;  // see the scene through the figure
   for (int i = 0; i < 3; ++i) f->linergb[0][i] = rgb[i];
-  f->linewidth = 2.0f;
+  f->linewidth = 1.0f;
   // the y axis from zero, grown with the data
   f->range[1][0] = 0.0f;
   f->range[1][1] = 1.0f;
@@ -40,12 +41,12 @@ std::string status_text(ControlStatus s) {
 }
 
 const char* hud_help_text() {
-  return "space pause | right one tick | s slow x1/4 | r reset | [ ] case | "
-         "+ - gains x2 /2 | m mouse hand | o overlay | p screenshot | "
-         "h help | esc quit\n"
-         "mouse hand: left-drag moves the hand's target, shift+left-drag "
-         "turns it | right-drag turns the camera, middle-drag pans "
-         "(scripted hand: left-drag too), scroll zooms";
+  return "space pause | right arrow one tick | s slow x1/4 | r reset | "
+         "[ ] case | + - gains x2 /2\n"
+         "m mouse/script hand | o overlay | p screenshot | h help | "
+         "esc quit\n"
+         "mouse hand: left-drag moves it, shift+left-drag turns it | "
+         "right-drag camera, middle-drag pan, scroll zoom";
 }
 
 Hud::Hud()
@@ -100,8 +101,10 @@ void Hud::draw(const mjrRect& viewport, const HudText& t, bool help,
     mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMLEFT, viewport, hud_help_text(),
                 nullptr, con);
   }
+  // each plot a third of the width and at least 200 px high: MuJoCo's
+  // labels take about 100 px of it
   const int w = viewport.width / 3;
-  const int h = viewport.height / 4;
+  const int h = std::max(viewport.height / 4, 200);
   const mjrRect top{viewport.left + viewport.width - w,
                     viewport.bottom + viewport.height - h, w, h};
   const mjrRect below{top.left, top.bottom - h, w, h};

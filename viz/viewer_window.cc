@@ -65,7 +65,7 @@ Viewer::Window::Window(int width_px, int height_px, const char* title,
   if (glfwInit() != GLFW_TRUE) {
     throw ViewerError("cannot open a window: GLFW: " + last_glfw_error());
   }
-  glfwWindowHint(GLFW_SAMPLES, 4);
+  glfwWindowHint(GLFW_SAMPLES, 0);
   glfw = glfwCreateWindow(width_px, height_px, title, nullptr, nullptr);
   if (glfw == nullptr) {
     const std::string why = last_glfw_error();
