@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -80,10 +81,14 @@ TEST(ViewerSmoke, MouseHandDragsTheStylusAndTheForceArrowAppears) {
   const Vec3 moved = site_m(v, "wrist") - wrist0;
   const double commanded_m = 30.0 * m_per_px;  // how far the target went
   const double along_m = moved.dot(right);
+  std::printf("[ info     ] target dragged %.2f mm, wrist followed %.2f mm "
+              "along the camera's right\n",
+              1e3 * commanded_m, 1e3 * along_m);
   // the VM's spring (0.5 N/mm) resists the hand's (0.135 N/mm) across the
-  // path, so the wrist follows only part of the way; but it goes the way
-  // the cursor went, and more than a tenth of it
-  EXPECT_GT(along_m, 0.1 * commanded_m)
+  // path, so the wrist need not follow all the way (about 80 % here, where
+  // the drag runs mostly along the circle); but it goes the way the cursor
+  // went, by a good part of it, and not past it
+  EXPECT_GT(along_m, 0.3 * commanded_m)
       << "moved " << moved.transpose() << " m, target " << commanded_m << " m";
   EXPECT_LT(along_m, 1.2 * commanded_m);
 
