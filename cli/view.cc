@@ -133,7 +133,16 @@ void view(const ViewOptions& o) {
   vo.width_px = o.width_px;
   vo.height_px = o.height_px;
   std::unique_ptr<LiveDevice> live;
-  if (!o.device.empty()) live = open_live(o, scene, &vo);
+  if (!o.device.empty()) {
+    live = open_live(o, scene, &vo);
+  } else {
+    // bad --set values are usage errors even where no window can open
+    try {
+      sim::ClosedLoop check(scene, o.sets);
+    } catch (const sim::SimError& e) {
+      throw UsageError(std::string("view: ") + e.what());
+    }
+  }
 
   std::unique_ptr<viz::Viewer> viewer;
   try {

@@ -160,6 +160,7 @@ void Viewer::copy_from_physics() {
 void Viewer::render() {
   const mjModel* m = model();
   win_->framebuffer_size(&width_px_, &height_px_);
+  win_height_px_ = win_->window_height_px();
   const mjrRect viewport{0, 0, width_px_, height_px_};
   mjv_updateScene(m, d_render_, &vopt_, nullptr, &cam_, mjCAT_ALL, &scn_);
   prims_.clear();

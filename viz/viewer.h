@@ -141,6 +141,8 @@ class Viewer {
  private:
   void open_window();
   void build_case();          // (re)builds the loop of cases_[case_index_]
+  // build_case for another case or gain scale; on failure, back as it was
+  void rebuild_or_keep(int case_index, double gain_scale);
   void copy_from_physics();
   void render();
   void screenshot();
@@ -162,7 +164,8 @@ class Viewer {
   // the window and MuJoCo's visualisation state (render thread only)
   struct Window;
   std::unique_ptr<Window> win_;
-  int width_px_ = 0, height_px_ = 0;
+  int width_px_ = 0, height_px_ = 0;  // the framebuffer
+  int win_height_px_ = 0;             // the window, for mouse drags
   mjvCamera cam_;
   mjvOption vopt_;
   mjvScene scn_;

@@ -3,6 +3,8 @@
 #include <GLFW/glfw3.h>
 
 #include <cmath>
+#include <cstdio>
+#include <exception>
 
 #include "viz/mouse_hand.h"
 #include "viz/viewer.h"
@@ -83,8 +85,8 @@ void Viewer::handle_key(const InputEvent& e) {
     case GLFW_KEY_LEFT_BRACKET:
       if (sim_only && opt_.cases.size() > 1) {
         const int n = static_cast<int>(opt_.cases.size());
-        case_index_ = (case_index_ + (e.key == GLFW_KEY_RIGHT_BRACKET ? 1 : n - 1)) % n;
-        build_case();
+        const int step = e.key == GLFW_KEY_RIGHT_BRACKET ? 1 : n - 1;
+        rebuild_or_keep((case_index_ + step) % n, gain_scale_);
       }
       break;
     case GLFW_KEY_EQUAL:  // '+' is shift+'=' on most layouts
@@ -93,8 +95,7 @@ void Viewer::handle_key(const InputEvent& e) {
     case GLFW_KEY_KP_SUBTRACT:
       if (sim_only) {
         const bool up = e.key == GLFW_KEY_EQUAL || e.key == GLFW_KEY_KP_ADD;
-        gain_scale_ *= up ? 2.0 : 0.5;
-        build_case();
+        rebuild_or_keep(case_index_, gain_scale_ * (up ? 2.0 : 0.5));
       }
       break;
     case GLFW_KEY_M:
@@ -117,6 +118,23 @@ void Viewer::handle_key(const InputEvent& e) {
   }
 }
 
+void Viewer::rebuild_or_keep(int case_index, double gain_scale) {
+  const int old_index = case_index_;
+  const double old_scale = gain_scale_;
+  case_index_ = case_index;
+  gain_scale_ = gain_scale;
+  try {
+    build_case();
+  } catch (const std::exception& e) {
+    // e.g. a --set that suits one case and not the next: stay where we were
+    std::fprintf(stderr, "vmhaptics view: %s; kept %s\n", e.what(),
+                 opt_.cases[static_cast<std::size_t>(old_index)].name.c_str());
+    case_index_ = old_index;
+    gain_scale_ = old_scale;
+    build_case();
+  }
+}
+
 void Viewer::handle_button(const InputEvent& e) {
   if (e.button == GLFW_MOUSE_BUTTON_LEFT) left_down_ = e.press;
   if (e.button == GLFW_MOUSE_BUTTON_RIGHT) right_down_ = e.press;
@@ -133,7 +151,8 @@ void Viewer::handle_move(const InputEvent& e) {
   last_x_px_ = e.x_px;
   last_y_px_ = e.y_px;
   if (dx == 0.0 && dy == 0.0) return;
-  const int h = height_px_ > 0 ? height_px_ : opt_.height_px;
+  // drags are in window coordinates, which a HiDPI framebuffer scales
+  const int h = win_height_px_ > 0 ? win_height_px_ : opt_.height_px;
   if (left_down_ && mouse_hand_ && !opt_.live) {
     ViewCamera cam;
     cam.lookat_m = Vec3(cam_.lookat[0], cam_.lookat[1], cam_.lookat[2]);

@@ -94,6 +94,12 @@ void Viewer::Window::framebuffer_size(int* width_px, int* height_px) const {
   glfwGetFramebufferSize(glfw, width_px, height_px);
 }
 
+int Viewer::Window::window_height_px() const {
+  int w = 0, h = 0;
+  glfwGetWindowSize(glfw, &w, &h);
+  return h;
+}
+
 void Viewer::Window::swap() { glfwSwapBuffers(glfw); }
 
 void Viewer::Window::poll() { glfwPollEvents(); }

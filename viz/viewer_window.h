@@ -19,6 +19,7 @@ struct Viewer::Window {
 
   bool should_close() const;
   void framebuffer_size(int* width_px, int* height_px) const;
+  int window_height_px() const;
   void swap();
   static void poll();
 
