@@ -5,6 +5,7 @@
 
 #include <GLFW/glfw3.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -139,6 +140,16 @@ void Viewer::copy_from_physics() {
                      out_.p_rm_mm / overlay_controller_->params().length_unit_mm) *
                  overlay_controller_->params().length_unit_mm;
     have_output_ = true;
+    // the plots from the readings the frames saw (no physics thread here)
+    auto& buf = *plots_;
+    if (live_plot_n_ == kPlotSamples) {
+      std::copy(buf.begin() + 1, buf.end(), buf.begin());
+      --live_plot_n_;
+    }
+    buf[static_cast<std::size_t>(live_plot_n_++)] = PlotSample{
+        static_cast<float>(s.t_s), static_cast<float>(d_path_mm_),
+        static_cast<float>(out_.force_device_N.norm())};
+    hud_->set_samples(buf.data(), live_plot_n_);
     return;
   }
   sim::TraceRow row;

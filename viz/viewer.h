@@ -184,6 +184,7 @@ class Viewer {
   std::vector<OverlayPrimitive> prims_;
   std::unique_ptr<Hud> hud_;
   std::unique_ptr<std::array<PlotSample, 1000>> plots_;  // kPlotSamples
+  int live_plot_n_ = 0;  // samples in plots_ from a live device
 
   // the mouse
   bool left_down_ = false, right_down_ = false, middle_down_ = false;
