@@ -32,6 +32,8 @@ void register_identify(CLI::App* app);
 #ifdef VMH_HAVE_VIZ
 // cli/render.cc: headless PNG renders of a case
 void register_render(CLI::App* app);
+// cli/view.cc: the interactive viewer
+void register_view(CLI::App* app);
 #endif
 }  // namespace vmh::cli
 
@@ -83,6 +85,7 @@ int main(int argc, char** argv) {
   vmh::cli::register_identify(&app);
 #ifdef VMH_HAVE_VIZ
   vmh::cli::register_render(&app);
+  vmh::cli::register_view(&app);
 #endif
 
   try {

@@ -232,7 +232,35 @@ void ClosedLoop::reset() {
     d->qpos[m->jnt_qposadr[j]] = q_start_dh_[i];
   }
   set_hand_target(0.0);
+  manual_target_ = hand_->target();
   mj_forward(m, d);
+}
+
+void ClosedLoop::set_manual_hand(bool on) {
+  if (on && !manual_hand_) {
+    manual_target_ = hand_->target();
+    manual_target_.v_m_s.setZero();
+    manual_target_.w_rad_s.setZero();
+  }
+  manual_hand_ = on;
+}
+
+void ClosedLoop::set_manual_target(const HandTargetState& target) {
+  manual_target_ = target;
+}
+
+ScriptPose ClosedLoop::wrist_pose_of(const HandTargetState& grip) const {
+  const mjModel* m = model_.get();
+  const int g = hand_->grip_site();
+  const Vec3 grip_local(m->site_pos + 3 * g);
+  RowMat3 R_site;
+  mju_quat2Mat(R_site.data(), m->site_quat + 4 * g);
+  // undo set_hand_target's grip = wrist + R grip_local, R_grip = R R_site
+  const Mat3 R = grip.R * R_site.transpose();
+  ScriptPose pose;
+  pose.p_mm = base_to_device_mm(params_.omni, grip.p_m - R * grip_local);
+  pose.axis = base_to_device_vector(R.col(2));
+  return pose;
 }
 
 void ClosedLoop::set_hand_target(double t_s) {
@@ -281,10 +309,15 @@ Vec3 ClosedLoop::nearest_on_path_mm(const Vec3& p_mm) const {
 void ClosedLoop::tick(TraceRow* row) {
   const double t = time_s();
   row->t_s = t;
-  set_hand_target(t);
   const double t_script = std::min(t, duration_s_);
   row->segment = script_->segment_at(t_script);
-  row->hand_target = script_->at(t_script);
+  if (manual_hand_) {
+    hand_->set_target(model_.get(), data_.get(), manual_target_);
+    row->hand_target = wrist_pose_of(manual_target_);
+  } else {
+    set_hand_target(t);
+    row->hand_target = script_->at(t_script);
+  }
 
   injector_->set_time_s(t);
   row->servo = servo_tick(guard_.get(), controller_.get(), &row->out);

@@ -147,6 +147,19 @@ class ClosedLoop {
   // data() itself (a viewer, a test) does to play the script.
   void set_hand_target(double t_s);
 
+  // Manual hand (a viewer's mouse in the script's place): while on, tick()
+  // holds the manual target instead of the script's (the hand's impedance
+  // still acts at every physics step), and TraceRow::hand_target is the
+  // wrist pose that target asks for. Turning it on starts from the target
+  // the hand holds now, so nothing jumps; reset() keeps the mode and puts
+  // the manual target back at the script's start. Off by default: the
+  // script plays as before.
+  void set_manual_hand(bool on);
+  bool manual_hand() const { return manual_hand_; }
+  // the grip's target (world = DH base frame, SI), used from the next tick
+  void set_manual_target(const HandTargetState& target);
+  const HandTargetState& manual_target() const { return manual_target_; }
+
   // distance (mm) from a device-frame point to the VM's path: the circle,
   // the sphere or the plane, in closed form (VirtualMechanism::
   // distance_to_path)
@@ -170,6 +183,8 @@ class ClosedLoop {
 
   // the next tick's physics steps (drawn when jittered)
   int draw_substeps();
+  // the wrist pose (device frame) a grip target asks for
+  ScriptPose wrist_pose_of(const HandTargetState& grip) const;
 
   std::string path_;
   ModelPtr model_;
@@ -196,6 +211,8 @@ class ClosedLoop {
   std::uint64_t jitter_seed_ = 1;
   std::uint64_t rng_state_ = 1;
   long substep_count_ = 0;  // physics steps since t = 0
+  bool manual_hand_ = false;
+  HandTargetState manual_target_;
   // passivity observer
   double energy_motor_J_ = 0.0;
   double energy_hand_J_ = 0.0;

@@ -213,5 +213,63 @@ TEST(ClosedLoopTest, TheHandIsRegisteredForItsDataOnly) {
   EXPECT_EQ(registered_hand(d), nullptr);
 }
 
+// The manual hand holds the target it is given: with the controller's
+// gains at zero nothing but the hand acts on the grip, so the grip ends
+// near a target 20 mm away; the row reports that target's wrist pose, and
+// the script's wrist pose comes back out of the script's own grip target
+// (the inverse of set_hand_target's placement, computed separately).
+TEST(ClosedLoopTest, ManualTargetPullsTheGrip) {
+  testing::MujocoGuard guard;
+  ClosedLoop loop(scene(1), {"k_pos_N_per_mm=0", "k_ornt_multiple=0"});
+  TraceRow row;
+  for (int k = 0; k < 50; ++k) loop.tick(&row);
+  EXPECT_FALSE(loop.manual_hand());
+  // off: the row's target is the script's, and the manual one starts from
+  // where the hand holds now
+  const ScriptPose scripted = loop.script().at(row.t_s);
+  EXPECT_NEAR((row.hand_target.p_mm - scripted.p_mm).norm(), 0.0, 1e-12);
+  loop.set_manual_hand(true);
+  HandTargetState target = loop.manual_target();
+  EXPECT_NEAR((target.p_m - loop.hand().target().p_m).norm(), 0.0, 1e-15);
+  EXPECT_EQ(target.v_m_s, Vec3::Zero());
+
+  const int g = loop.hand().grip_site();
+  const Vec3 grip0(loop.data()->site_xpos + 3 * g);
+  const Vec3 move_m(0.0, 0.012, 0.016);  // 20 mm, world frame
+  target.p_m += move_m;
+  loop.set_manual_target(target);
+  for (int k = 0; k < 2000; ++k) loop.tick(&row);
+  const Vec3 grip1(loop.data()->site_xpos + 3 * g);
+  const Vec3 moved = grip1 - grip0;
+  // along the move by most of its 20 mm, and little across it
+  EXPECT_GT(moved.dot(move_m.normalized()), 0.8 * move_m.norm());
+  EXPECT_LT((moved - moved.dot(move_m.normalized()) * move_m.normalized()).norm(),
+            0.2 * move_m.norm());
+  // the hand still holds the manual target, not the script's
+  EXPECT_NEAR((loop.hand().target().p_m - target.p_m).norm(), 0.0, 1e-15);
+  // the row's wrist pose is the target's: the wrist is where the grip site
+  // sits on the stylus body (its offset from the model), device frame
+  const mjModel* m = loop.model();
+  const Vec3 grip_local(m->site_pos + 3 * g);
+  mjtNum R_site[9];
+  mju_quat2Mat(R_site, m->site_quat + 4 * g);
+  Mat3 Rs;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) Rs(r, c) = R_site[3 * r + c];
+  const Mat3 R_wrist = target.R * Rs.transpose();
+  const Vec3 wrist_m = target.p_m - R_wrist * grip_local;
+  const Vec3 expect_mm =
+      base_to_device_mm(loop.controller_params().omni, wrist_m);
+  EXPECT_NEAR((row.hand_target.p_mm - expect_mm).norm(), 0.0, 1e-9);
+  EXPECT_NEAR(row.hand_target.axis.norm(), 1.0, 1e-12);
+
+  // back to the script: the next tick's target is the script's again
+  loop.set_manual_hand(false);
+  loop.tick(&row);
+  EXPECT_NEAR((row.hand_target.p_mm - loop.script().at(row.t_s).p_mm).norm(),
+              0.0, 1e-12);
+  EXPECT_GT((loop.hand().target().p_m - target.p_m).norm(), 0.01);
+}
+
 }  // namespace
 }  // namespace vmh::sim

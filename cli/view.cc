@@ -1,0 +1,206 @@
+// vmhaptics view <case1..case6|scene.xml> [--device D] [--frames N]
+//                [--set name=value ...] [--out DIR] [--mouse]
+//
+// An interactive window (viz/viewer.h, docs/viewer.md): the case's Omni in
+// MuJoCo's renderer, simulated in real time, with the mouse able to take
+// the simulated hand's place; or, with --device, a device's live state.
+// Exit codes: 0 closed, 2 bad usage or input (an unknown case, a bad
+// --set, a device that cannot be opened), 1 any other failure (no display:
+// GLFW's reason is in the message).
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <memory>
+
+#include "cli/args.h"
+#include "cli/hw_backends.h"
+#include "cli/hw_loop.h"
+#include "controller/device_frame.h"
+#include "sim/closed_loop.h"
+#include "studies/run_case.h"
+#include "viz/viewer.h"
+
+namespace vmh::cli {
+namespace {
+
+struct ViewOptions {
+  std::string target;
+  std::string device;  // empty: the viewer's own simulation
+  int frames = 0;
+  std::vector<std::string> sets;
+  std::string out = ".";
+  bool mouse = false;
+  bool screenshot = false;
+  int width_px = 1280;
+  int height_px = 800;
+};
+
+// the device's servo loop running the case's controller, watched by the
+// viewer through HwLoop::latest() (a Seqlock: the loop never waits)
+struct LiveDevice {
+  OpenedDevice dev;
+  SessionOptions session;
+  std::unique_ptr<HwLoop> loop;
+  ~LiveDevice() {
+    if (dev.backend) dev.backend->stop();  // zero torque at the device
+  }
+};
+
+std::unique_ptr<LiveDevice> open_live(const ViewOptions& o,
+                                      const std::string& scene,
+                                      viz::ViewerOptions* vo) {
+  DeviceSpec spec = parse_device_spec(o.device);
+  if (spec.backend == "emulator") {
+    if (!spec.argument.empty()) {
+      throw UsageError("view: the emulator plays the viewed scene; give it "
+                       "as the target, not in --device (" + o.device + ")");
+    }
+    spec.argument = scene;
+  }
+  // the case's controller, as hw run builds it
+  ControllerParams params;
+  try {
+    params = sim::ClosedLoop(scene, o.sets).controller_params();
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("view: ") + e.what());
+  }
+  auto live = std::make_unique<LiveDevice>();
+  OpenOptions oo;
+  oo.overrides = o.sets;
+  oo.hand = "case";
+  live->dev = open_device(spec, oo);
+  SessionOptions& so = live->session;
+  so.mode = HwMode::kRun;
+  so.duration_s = 1e9;  // until the window closes
+  so.controller = params;
+  so.servo.period_s = params.servo_period_s;
+  so.servo.realtime = false;
+  so.safety.servo_period_s = params.servo_period_s;
+  so.guard.max_period_s = 4.0 * params.servo_period_s;
+  live->loop = std::make_unique<HwLoop>(live->dev.backend->device(), so,
+                                        params.omni, live->dev.emulator);
+  live->dev.backend->start(live->loop.get(), so.servo);
+  HwLoop* loop = live->loop.get();
+  vo->live = [loop] {
+    const HwSample s = loop->latest();
+    viz::LiveSample out;
+    out.valid = loop->ticks() > 0 && s.state.present != 0;
+    out.t_s = s.t_s;
+    out.q_device_rad = s.state.q_device_rad;
+    out.out = s.out;
+    out.status = "safety " + safety_flags_text(s.safety);
+    return out;
+  };
+  vo->live_name = o.device;
+  return live;
+}
+
+void view(const ViewOptions& o) {
+  if (o.frames < 0) throw UsageError("--frames: must be >= 0");
+  if (o.width_px < 64 || o.height_px < 64) {
+    throw UsageError("--width, --height: each must be at least 64 px");
+  }
+  viz::ViewerOptions vo;
+  std::string name;
+  std::string scene;
+  try {
+    scene = studies::resolve_scene(o.target, &name);
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("view: ") + e.what());
+  }
+  // the thesis cases to step through with [ and ]; a scene file alone
+  for (const studies::CaseEntry& c : studies::thesis_cases()) {
+    std::string n;
+    vo.cases.push_back({c.name, studies::resolve_scene(c.name, &n)});
+    if (n == name) vo.case_index = static_cast<int>(vo.cases.size()) - 1;
+  }
+  if (vo.cases[static_cast<std::size_t>(vo.case_index)].name != name) {
+    vo.cases = {{name, scene}};
+    vo.case_index = 0;
+  }
+  std::error_code ec;
+  if (!std::filesystem::is_directory(o.out, ec)) {
+    throw UsageError("--out: no such directory '" + o.out + "'");
+  }
+  vo.overrides = o.sets;
+  vo.max_frames = o.frames;
+  vo.out_dir = o.out;
+  vo.start_with_mouse_hand = o.mouse;
+  if (o.screenshot && o.frames == 0) {
+    throw UsageError("--screenshot: needs --frames N (the last frame's)");
+  }
+  vo.screenshot_last_frame = o.screenshot;
+  vo.width_px = o.width_px;
+  vo.height_px = o.height_px;
+  std::unique_ptr<LiveDevice> live;
+  if (!o.device.empty()) {
+    live = open_live(o, scene, &vo);
+  } else {
+    // bad --set values are usage errors even where no window can open
+    try {
+      sim::ClosedLoop check(scene, o.sets);
+    } catch (const sim::SimError& e) {
+      throw UsageError(std::string("view: ") + e.what());
+    }
+  }
+
+  std::unique_ptr<viz::Viewer> viewer;
+  try {
+    viewer = std::make_unique<viz::Viewer>(vo);
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("view: ") + e.what());
+  } catch (const viz::ViewerError& e) {
+    throw std::runtime_error(std::string("view: ") + e.what());
+  }
+  viewer->run();
+  std::fprintf(stderr,
+               "vmhaptics view: %ld frames, %.1f frames/s, real-time factor "
+               "%.2f\n",
+               viewer->frames(), viewer->frames_per_s(),
+               viewer->realtime_factor());
+}
+
+}  // namespace
+
+void register_view(CLI::App* app) {
+  auto o = std::make_shared<ViewOptions>();
+  CLI::App* cmd = app->add_subcommand(
+      "view",
+      "interactive window: the case's Omni in MuJoCo's renderer, simulated "
+      "in real time (1 kHz servo), the virtual mechanism drawn over it, "
+      "live plots of the path error and |F|; the mouse can take the "
+      "simulated hand's place (key m). Keys: space pause, right arrow one "
+      "servo tick, s slow motion x1/4, r reset, [ ] previous/next case, "
+      "+ - gains x2 /2, m mouse/scripted hand, o overlay, p screenshot, "
+      "h help, esc quit. Mouse hand: left-drag moves the hand's target in "
+      "the view plane, shift+left-drag turns it; right-drag turns the "
+      "camera, middle-drag pans, scroll zooms. docs/viewer.md");
+  cmd->add_option("target", o->target,
+                  "case1..case6, or the path of a scene .xml")
+      ->required();
+  cmd->add_option("--device", o->device,
+                  "show a device's live state instead of simulating: "
+                  "emulator (plays the target scene) or a backend as in the "
+                  "hw verbs (openhaptics[:CONFIG]); the case's controller "
+                  "drives it through the safety layer");
+  cmd->add_option("--frames", o->frames,
+                  "exit after N frames (0: when the window is closed)");
+  cmd->add_option("--set", o->sets,
+                  "override a case parameter, name=value (vectors "
+                  "comma-separated); repeatable. docs/parameters.md lists the "
+                  "names")
+      ->allow_extra_args(false);
+  cmd->add_option("--out", o->out,
+                  "directory for screenshots (key p; default: the current "
+                  "one), named vmhaptics-view-<case>-<local time>.png");
+  cmd->add_flag("--mouse", o->mouse,
+                "start with the mouse hand instead of the case's script");
+  cmd->add_flag("--screenshot", o->screenshot,
+                "with --frames N: write a screenshot of the last frame to "
+                "--out before exiting");
+  cmd->add_option("--width", o->width_px, "window width in px (1280)");
+  cmd->add_option("--height", o->height_px, "window height in px (800)");
+  cmd->callback([o] { view(*o); });
+}
+
+}  // namespace vmh::cli

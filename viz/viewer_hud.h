@@ -1,0 +1,58 @@
+// The viewer's text panel and live plots, drawn over the 3-D view with
+// MuJoCo's 2-D renderer (mjr_overlay, mjr_figure).
+#ifndef VMHAPTICS_VIZ_VIEWER_HUD_H_
+#define VMHAPTICS_VIZ_VIEWER_HUD_H_
+
+#include <memory>
+#include <string>
+
+#include <mujoco/mujoco.h>
+
+#include "controller/controller.h"
+#include "viz/viewer_physics.h"
+
+namespace vmh::viz {
+
+// The names of the status flags up in `s`, '|'-joined ("ok" for none).
+std::string status_text(ControlStatus s);
+
+// What the panel says, one line each.
+struct HudText {
+  std::string case_name;
+  std::string hand;          // "script" or "mouse", or the device
+  double k_pos_N_per_mm = 0.0;
+  double k_ornt_Nmm_per_rad = 0.0;
+  double gain_scale = 1.0;
+  double force_N = 0.0;
+  double path_error_mm = 0.0;
+  std::string status;
+  double t_sim_s = 0.0;
+  double realtime_factor = 0.0;
+  double frames_per_s = 0.0;
+  bool paused = false;
+  bool slow = false;
+};
+
+// The key help line (docs/viewer.md lists the same).
+const char* hud_help_text();
+
+class Hud {
+ public:
+  Hud();
+  ~Hud();
+  // the plots' data: samples oldest first, the last kPlotWindow_s of them
+  void set_samples(const PlotSample* samples, int n);
+  // draws the panel (top left), the help (bottom left, when `help`) and the
+  // two plots (right) in `viewport`
+  void draw(const mjrRect& viewport, const HudText& text, bool help,
+            const mjrContext* con);
+
+ private:
+  // mjvFigure holds 100 lines of 1000 points: 0.8 MB each, on the heap
+  std::unique_ptr<mjvFigure> error_fig_;
+  std::unique_ptr<mjvFigure> force_fig_;
+};
+
+}  // namespace vmh::viz
+
+#endif  // VMHAPTICS_VIZ_VIEWER_HUD_H_
