@@ -28,6 +28,8 @@
 namespace vmh::cli {
 // cli/identify.cc: fit the Omni model to recordings
 void register_identify(CLI::App* app);
+// cli/report.cc: the HTML report of the cases and the studies
+void register_report(CLI::App* app);
 }  // namespace vmh::cli
 
 namespace {
@@ -76,6 +78,7 @@ int main(int argc, char** argv) {
   vmh::cli::register_hw(&app);
   vmh::cli::register_compare(&app);
   vmh::cli::register_identify(&app);
+  vmh::cli::register_report(&app);
 
   try {
     check_verbs(&app, argc, argv);

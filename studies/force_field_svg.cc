@@ -68,7 +68,7 @@ std::string panel(const std::vector<ForceSample>& s,
        attr("width", px(kPanel_px)) + attr("height", px(kPanel_px)) +
        " fill=\"none\" stroke=\"#444\"/>\n";
   g += "<text" + attr("x", px(left + kPanel_px / 2)) +
-       attr("y", px(top + kPanel_px + 30)) + " text-anchor=\"middle\">" +
+       attr("y", px(top + kPanel_px + 32)) + " text-anchor=\"middle\">" +
        escape(std::string(axis_name(v.across)) + " (mm, device frame)") +
        "</text>\n";
   g += "<text" + attr("x", px(left - 12)) + attr("y", px(top + kPanel_px / 2)) +
@@ -76,6 +76,28 @@ std::string panel(const std::vector<ForceSample>& s,
                              px(top + kPanel_px / 2) + ")") +
        " text-anchor=\"middle\">" +
        escape(std::string(axis_name(v.up)) + " (mm)") + "</text>\n";
+  // ticks in mm on both axes, at a step giving about five of them
+  const double step = report::svg::nice_step(span, 5.0);
+  for (int axis = 0; axis < 2; ++axis) {
+    const double c = axis == 0 ? c0 : c1;
+    for (double t = std::ceil((c - span / 2) / step) * step; t <= c + span / 2;
+         t += step) {
+      const std::string label = num(std::abs(t) < 1e-9 * step ? 0.0 : t);
+      if (axis == 0) {
+        g += "<line" + attr("x1", px(X(t))) + attr("y1", px(top + kPanel_px)) +
+             attr("x2", px(X(t))) + attr("y2", px(top + kPanel_px + 4)) +
+             " stroke=\"#444\"/>\n<text" + attr("x", px(X(t))) +
+             attr("y", px(top + kPanel_px + 15)) +
+             " text-anchor=\"middle\">" + label + "</text>\n";
+      } else {
+        g += "<line" + attr("x1", px(left - 4)) + attr("y1", px(Y(t))) +
+             attr("x2", px(left)) + attr("y2", px(Y(t))) +
+             " stroke=\"#444\"/>\n<text" + attr("x", px(left + 3)) +
+             attr("y", px(Y(t) - 2)) + " fill=\"#666\">" + label +
+             "</text>\n";
+      }
+    }
+  }
   // the path: a circle of radius L about the pivot (the sphere's outline in
   // a projection along a device axis)
   if (path.length_mm > 0.0) {
@@ -133,8 +155,11 @@ std::string force_field_svg(const std::vector<ForceSample>& samples,
   } else {
     views = {{"xy", 0, 1}, {"xz", 0, 2}, {"zy", 2, 1}};
   }
-  const double width = kMargin_px + static_cast<double>(views.size()) * (kPanel_px + kMargin_px);
-  const double height = kTitle_px + kPanel_px + 44.0;
+  // wide enough for the caption over one panel
+  const double width = std::max(
+      760.0, kMargin_px + static_cast<double>(views.size()) *
+                              (kPanel_px + kMargin_px));
+  const double height = kTitle_px + kPanel_px + 46.0;
   std::string svg =
       "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\"" +
       attr("width", px(width)) + attr("height", px(height)) +
