@@ -12,7 +12,6 @@
 #include <chrono>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -27,7 +26,6 @@
 #include "report/parallel.h"
 #include "report/progress.h"
 #include "studies/extremes_study.h"
-#include "studies/force_field_svg.h"
 #include "studies/precision_study.h"
 #include "studies/report_html.h"
 #include "studies/run_case.h"
@@ -63,11 +61,7 @@ constexpr MapSetting kMapQuick{2e-5, 5};
 constexpr double kQuickPrecisionDuration_s = 1.0;
 
 std::string read_text(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  if (!f) return "";
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
+  return studies::read_file_text(p.string());
 }
 
 bool all_exist(const fs::path& dir, std::initializer_list<const char*> names) {
@@ -139,42 +133,6 @@ std::string map_note(const studies::StabilityOptions& so) {
     << " N s/m in " << so.map_virtual_damping_Ns_per_m.size()
     << " values, delays 0, 1 and 2 ticks";
   return s.str();
-}
-
-// One case from its files: the summary, the SVGs, and the force field from
-// the trace and the case's parameters.
-studies::ReportCase load_case(const fs::path& dir, const std::string& name,
-                              const studies::RenderFn& render) {
-  studies::ReportCase c;
-  c.name = name;
-  const fs::path d = dir / name;
-  try {
-    c.summary = nlohmann::json::parse(read_text(d / "summary.json"));
-  } catch (const std::exception& e) {
-    throw std::runtime_error((d / "summary.json").string() + ": " + e.what());
-  }
-  c.views_svg = read_text(d / "views.svg");
-  c.history_svg = read_text(d / "history.svg");
-  const nlohmann::json& p = c.summary.at("parameters");
-  studies::ForceFieldPath path;
-  path.vm_kind = p.at("vm_kind").at("value").get<std::string>();
-  const auto pivot = p.at("vm_pivot_mm").at("value").get<std::vector<double>>();
-  for (std::size_t i = 0; i < 3 && i < pivot.size(); ++i) path.pivot_mm[i] = pivot[i];
-  path.length_mm = p.at("vm_length_mm").at("value").get<double>();
-  try {
-    c.force_field_svg = studies::force_field_svg(
-        studies::force_samples_from_csv(read_text(d / "trace.csv")), path);
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error((d / "trace.csv").string() + ": " + e.what());
-  }
-  std::string why;
-  if (render) {
-    c.render_png = render(name, c.summary.value("scene", ""), &why);
-  } else {
-    why = "no renderer in this build";
-  }
-  if (!c.render_png) c.render_note = why.empty() ? "the renderer gave none" : why;
-  return c;
 }
 
 void run(const ReportCli& o) {
@@ -256,7 +214,7 @@ void run(const ReportCli& o) {
   // GLFW); until then every case shows "render unavailable"
   const studies::RenderFn render;
   for (const studies::CaseEntry& c : studies::thesis_cases()) {
-    in.cases.push_back(load_case(dir, c.name, render));
+    in.cases.push_back(studies::load_report_case(dir.string(), c.name, render));
   }
   studies::ReportStudies& st = in.studies;
   st.precision_case = precision.name;

@@ -2,9 +2,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include "report/svg_text.h"
+#include "studies/force_field_svg.h"
 
 namespace vmh::studies {
 namespace {
@@ -225,6 +229,55 @@ std::string list_text(const std::vector<std::string>& v) {
 }
 
 }  // namespace
+
+ReportCase load_report_case(const std::string& dir, const std::string& name,
+                            const RenderFn& render) {
+  namespace fs = std::filesystem;
+  auto read_text = [](const fs::path& p) { return read_file_text(p.string()); };
+  ReportCase c;
+  c.name = name;
+  const fs::path d = fs::path(dir) / name;
+  try {
+    c.summary = nlohmann::json::parse(read_text(d / "summary.json"));
+  } catch (const std::exception& e) {
+    throw std::runtime_error((d / "summary.json").string() + ": " + e.what());
+  }
+  c.views_svg = read_text(d / "views.svg");
+  c.history_svg = read_text(d / "history.svg");
+  ForceFieldPath path;
+  try {
+    const nlohmann::json& p = c.summary.at("parameters");
+    path.vm_kind = p.at("vm_kind").at("value").get<std::string>();
+    const auto pivot = p.at("vm_pivot_mm").at("value").get<std::vector<double>>();
+    for (std::size_t i = 0; i < 3 && i < pivot.size(); ++i) path.pivot_mm[i] = pivot[i];
+    path.length_mm = p.at("vm_length_mm").at("value").get<double>();
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error((d / "summary.json").string() +
+                             ": the VM's parameters: " + e.what());
+  }
+  try {
+    c.force_field_svg = force_field_svg(
+        force_samples_from_csv(read_text(d / "trace.csv")), path);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error((d / "trace.csv").string() + ": " + e.what());
+  }
+  std::string why;
+  if (render) {
+    c.render_png = render(name, c.summary.value("scene", ""), &why);
+  } else {
+    why = "no renderer in this build";
+  }
+  if (!c.render_png) c.render_note = why.empty() ? "the renderer gave none" : why;
+  return c;
+}
+
+std::string read_file_text(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return "";
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
 
 ClaimTally tally_claims(const std::vector<ReportCase>& cases) {
   ClaimTally t;

@@ -61,6 +61,17 @@ struct ReportInputs {
   ReportStudies studies;
 };
 
+// One case from the files run_case wrote under dir/<name>/: summary.json,
+// views.svg and history.svg as they are, the force field drawn from
+// trace.csv and the case's VM parameters, and the render if `render` gives
+// one (empty `render`: a note says there is no renderer). Throws
+// std::runtime_error naming the file that is missing or unreadable.
+ReportCase load_report_case(const std::string& dir, const std::string& name,
+                            const RenderFn& render);
+
+// a whole file's bytes; "" if it cannot be read
+std::string read_file_text(const std::string& path);
+
 // claims over every case's summary.json
 struct ClaimTally {
   int passed = 0;
