@@ -336,7 +336,7 @@ std::string report_html(const ReportInputs& in) {
        "thesis's cases measured</h1>\n";
   s += "<table class=\"header\">\n";
   s += "<tr>" + th("software") + td("vmhaptics " + h.version) + "</tr>\n";
-  s += "<tr>" + th("git describe") + td(h.git_describe) + "</tr>\n";
+  s += "<tr>" + th("git describe (at configure time)") + td(h.git_describe) + "</tr>\n";
   s += "<tr>" + th("generated (UTC)") + td(h.generated_utc) + "</tr>\n";
   s += "<tr>" + th("command line") + td(h.command_line) + "</tr>\n";
   s += "<tr>" + th("cores") + td(std::to_string(h.cores)) + "</tr>\n";

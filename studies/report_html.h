@@ -27,7 +27,7 @@ using RenderFn = std::function<std::optional<std::string>(
 
 struct ReportHeader {
   std::string version;       // VMH_VERSION
-  std::string git_describe;  // at build time, or "unknown"
+  std::string git_describe;  // when the build was configured, or "unknown"
   std::string generated_utc;  // ISO 8601
   std::string command_line;
   int cores = 0;

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <filesystem>
 #include <regex>
 #include <string>
@@ -149,7 +150,18 @@ TEST(ReportHtmlTest, RealRunsOfTheSixCasesAreAllOnThePage) {
     std::string name;
     jobs.push_back({c.name, resolve_scene(c.name, &name), {}, {}, false});
   }
-  run_cases(&jobs, {}, dir.string(), 2);
+  // the progress callback, called from the two workers, ends at 6 of 6
+  std::atomic<std::size_t> last_done{0}, calls{0};
+  run_cases(&jobs, {}, dir.string(), 2, "",
+            [&](std::size_t done, std::size_t total) {
+              EXPECT_EQ(total, 6u);
+              ++calls;
+              std::size_t seen = last_done.load();
+              while (done > seen && !last_done.compare_exchange_weak(seen, done)) {
+              }
+            });
+  EXPECT_EQ(calls.load(), 6u);
+  EXPECT_EQ(last_done.load(), 6u);
   ReportInputs in;
   in.header.version = "test";
   for (const CaseJob& j : jobs) {
