@@ -41,7 +41,10 @@ bool is_terminal(int fd) { return isatty(fd) == 1; }
 
 Progress::Progress(std::string label, std::size_t total)
     : Progress(std::move(label), total, nullptr) {
-  if (is_terminal(fileno(stderr))) out_ = &std::cerr;
+  if (is_terminal(fileno(stderr))) {
+    out_ = &std::cerr;
+    if (total > 0) draw_locked(true);
+  }
 }
 
 Progress::Progress(std::string label, std::size_t total, std::ostream* out,
@@ -52,6 +55,8 @@ Progress::Progress(std::string label, std::size_t total, std::ostream* out,
       done_{0},
       total_{total} {
   start_s_ = clock_();
+  // shown at once, so that a slow first item is not mistaken for a hang
+  if (total > 0) draw_locked(true);
 }
 
 Progress::~Progress() { finish(); }
@@ -65,6 +70,7 @@ std::size_t Progress::add_part(std::size_t estimated_total) {
   std::lock_guard<std::mutex> lock(mutex_);
   done_.push_back(0);
   total_.push_back(estimated_total);
+  draw_locked(false);
   return done_.size() - 1;
 }
 

@@ -37,8 +37,9 @@ TEST(ProgressTest, DrawsGrowingPercentagesCountAndEta) {
     EXPECT_EQ(bar.done(), 4u);
   }
   const std::string s = out.str();
-  // each item drawn as it came (2 s apart), then the final state once more
-  EXPECT_EQ(percents(s), (std::vector<int>{25, 50, 75, 100, 100}));
+  // drawn at the start, each item as it came (2 s apart), then the final
+  // state once more
+  EXPECT_EQ(percents(s), (std::vector<int>{0, 25, 50, 75, 100, 100}));
   EXPECT_NE(s.find("1/4"), std::string::npos);
   EXPECT_NE(s.find("4/4"), std::string::npos);
   // after one item in 2 s, three are left at the same rate: 6 s
