@@ -29,6 +29,8 @@
 namespace vmh::cli {
 // cli/identify.cc: fit the Omni model to recordings
 void register_identify(CLI::App* app);
+// cli/report.cc: the HTML report of the cases and the studies
+void register_report(CLI::App* app);
 #ifdef VMH_HAVE_VIZ
 // cli/render.cc: headless PNG renders of a case
 void register_render(CLI::App* app);
@@ -83,6 +85,7 @@ int main(int argc, char** argv) {
   vmh::cli::register_hw(&app);
   vmh::cli::register_compare(&app);
   vmh::cli::register_identify(&app);
+  vmh::cli::register_report(&app);
 #ifdef VMH_HAVE_VIZ
   vmh::cli::register_render(&app);
   vmh::cli::register_view(&app);

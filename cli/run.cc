@@ -15,6 +15,7 @@
 #include <iostream>
 
 #include "cli/args.h"
+#include "report/progress.h"
 #include "studies/run_case.h"
 
 namespace vmh::cli {
@@ -92,7 +93,12 @@ void run(const RunOptions& o) {
   for (const auto& [name, scene] : jobs) {
     runs.push_back(studies::CaseJob{name, scene, {}, {}, false});
   }
-  studies::run_cases(&runs, sets, o.out, o.jobs, model);
+  {
+    // a bar on stderr (terminal only) for --all; one case is one item
+    report::Progress bar("run", runs.size());
+    studies::run_cases(&runs, sets, o.out, o.jobs, model,
+                       o.all ? bar.part(0) : report::ProgressFn{});
+  }
   std::vector<studies::CaseResult> results;
   for (const studies::CaseJob& j : runs) {
     if (!j.error.empty()) {

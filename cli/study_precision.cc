@@ -17,6 +17,7 @@
 #include "cli/json_util.h"
 #include "cli/study.h"
 #include "cli/study_files.h"
+#include "report/progress.h"
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
 #include "studies/precision_study.h"
@@ -139,7 +140,10 @@ void run(const PrecisionCli& o) {
   check_against_case(p);
   studies::PrecisionResult r;
   try {
-    r = studies::run_precision_study(p);
+    report::Progress bar("study precision", 0);
+    studies::PrecisionOptions with_bar = p;
+    with_bar.progress = bar.part(0);
+    r = studies::run_precision_study(with_bar);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study precision: ") + e.what());
   }

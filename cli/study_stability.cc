@@ -27,6 +27,7 @@
 #include "cli/json_util.h"
 #include "cli/study.h"
 #include "report/parallel.h"
+#include "report/progress.h"
 #include "studies/run_case.h"
 #include "studies/stability_study.h"
 
@@ -100,13 +101,17 @@ std::string number_text(double v) {
 }
 
 // the study, its bad input as bad usage, and its JSON on stdout
-void run_study(const studies::StabilityOptions& p) {
+// `bar` (if any) is finished before the JSON, so that a terminal shows it
+// whole above it
+void run_study(const studies::StabilityOptions& p,
+               report::Progress* bar = nullptr) {
   studies::StabilityResult r;
   try {
     r = studies::run_stability_study(p);
   } catch (const sim::SimError& e) {
     throw UsageError(e.what());
   }
+  if (bar != nullptr) bar->finish();
   std::cout << dump_readable(studies::stability_json(r)) << '\n';
 }
 
@@ -159,7 +164,11 @@ void run_map(const StabilityCli& o, const studies::StabilityParams& base) {
   }
   so.out_dir = o.out;
   make_out_dir(o.out);
-  run_study(so);
+  report::Progress bar("study stability --map",
+                       so.map_virtual_damping_Ns_per_m.size() *
+                           so.map_delay_ticks.size());
+  so.progress = bar.part(0);
+  run_study(so, &bar);
 }
 
 void run(const StabilityCli& o) {

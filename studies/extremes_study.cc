@@ -1,6 +1,7 @@
 #include "studies/extremes_study.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -480,6 +481,7 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
   result.energy.assign(table.size(), EnergyCurve{});
   std::vector<std::string> errors(table.size());
   const auto start = std::chrono::steady_clock::now();
+  std::atomic<std::size_t> finished{0};
   report::parallel_for(table.size(), o.jobs, [&](std::size_t i) {
     std::vector<TraceRow> rows;
     try {
@@ -493,6 +495,7 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
     } catch (const std::exception& e) {
       errors[i] = table[i].name + ": " + e.what();
     }
+    if (o.progress) o.progress(++finished, table.size());
   });
   for (const std::string& e : errors) {
     if (!e.empty()) throw SimError(e);

@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -164,6 +165,9 @@ struct ExtremesOptions {
   // where the files go (below); empty: nothing is written
   std::string out_dir;
   int jobs = 1;  // scenarios run at once, each on its own thread
+  // called from the workers with (scenarios done, scenarios); not set:
+  // nothing
+  std::function<void(std::size_t, std::size_t)> progress;
 };
 
 // The passivity observer E(t) of one scenario, thinned for the figure

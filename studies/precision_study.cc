@@ -446,9 +446,15 @@ PrecisionResult run_precision_study(const PrecisionOptions& o) {
   }
   const std::vector<Setting> settings = ladder(o, r);
 
+  const std::size_t runs = settings.size() + 1;
+  if (o.progress) o.progress(0, runs);
   const Trajectory ref = run_references(o, &r);
+  if (o.progress) o.progress(1, runs);
   // the ladder, one run at a time, so that the timings do not compete
-  for (const Setting& s : settings) r.rows.push_back(run_rung(o, s, ref, r));
+  for (const Setting& s : settings) {
+    r.rows.push_back(run_rung(o, s, ref, r));
+    if (o.progress) o.progress(r.rows.size() + 1, runs);
+  }
   fit_orders(o.integrators, &r);
   mark_fronts(&r);
 

@@ -26,6 +26,7 @@
 
 #include "controller/types.h"
 #include "sim/hand_script.h"
+#include "report/progress.h"
 #include "report/svg_chart.h"
 
 namespace vmh::studies {
@@ -61,6 +62,9 @@ struct PrecisionOptions {
   // where precision.csv, precision.svg and precision_order.svg go; empty:
   // nothing is written
   std::string out_dir;
+  // called with (runs done, runs) after the references (one item) and after
+  // each rung of the ladder; not set: nothing
+  report::ProgressFn progress;
 };
 
 // How one run differs from the reference, tick by tick.

@@ -1,6 +1,7 @@
 #include "studies/run_case.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -248,7 +249,9 @@ CaseResult run_case(const std::string& name, const std::string& scene,
 void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
                const std::string& out_dir, int threads,
-               const std::string& model_file) {
+               const std::string& model_file,
+               const report::ProgressFn& progress) {
+  std::atomic<std::size_t> finished{0};
   report::parallel_for(jobs->size(), threads > 0 ? threads : report::core_count(),
                [&](std::size_t i) {
                  CaseJob& job = (*jobs)[i];
@@ -261,6 +264,7 @@ void run_cases(std::vector<CaseJob>* jobs,
                  } catch (const std::exception& e) {
                    job.error = e.what();
                  }
+                 if (progress) progress(++finished, jobs->size());
                });
 }
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "report/progress.h"
 #include "studies/claims.h"
 
 namespace vmh::studies {
@@ -64,11 +65,13 @@ struct CaseJob {
 // Runs every job through run_case() on `threads` threads (0: one per core,
 // never more than there are jobs), each run in its own thread with its own
 // model and data. Exceptions are caught per job and recorded in it.
-// `model_file`: run_case's, for every job.
+// `model_file`: run_case's, for every job. `progress` (if set) is called
+// from the worker threads with (jobs finished, jobs) as each one ends.
 void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
                const std::string& out_dir, int threads,
-               const std::string& model_file = "");
+               const std::string& model_file = "",
+               const report::ProgressFn& progress = {});
 
 // summary.json's pieces, for other writers of the same format (hw run)
 nlohmann::json claim_json(const Claim& c);

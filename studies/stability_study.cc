@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -478,6 +479,7 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
     }
   }
   std::vector<std::exception_ptr> errors(points.size());
+  std::atomic<std::size_t> finished{0};
   report::parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
     try {
       const StabilityParams& p = params[i];
@@ -496,6 +498,7 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
     } catch (...) {
       errors[i] = std::current_exception();
     }
+    if (spec.progress) spec.progress(++finished, points.size());
   });
   for (const std::exception_ptr& e : errors) {
     if (e) std::rethrow_exception(e);
@@ -518,6 +521,7 @@ StabilityResult run_stability_study(const StabilityOptions& o) {
     spec.delay_ticks = o.map_delay_ticks;
     spec.rel_tol = o.rel_tol;
     spec.jobs = o.jobs;
+    spec.progress = o.progress;
     const auto t0 = std::chrono::steady_clock::now();
     r.map = stability_map(o.model_path, spec);
     r.wall_time_s =

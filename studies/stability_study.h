@@ -59,6 +59,7 @@
 #include <string>
 #include <vector>
 
+#include "report/progress.h"
 #include "report/svg_chart.h"
 #include "sim/mujoco_util.h"
 
@@ -240,6 +241,8 @@ struct MapSpec {
   std::vector<int> delay_ticks;
   double rel_tol = 2e-3;
   int jobs = 1;  // threads, each with its own model and data
+  // called from the workers with (points done, points); not set: nothing
+  report::ProgressFn progress;
 };
 
 struct MapPoint {
@@ -269,6 +272,7 @@ struct StabilityOptions {
   std::vector<double> map_virtual_damping_Ns_per_m;
   std::vector<int> map_delay_ticks;
   int jobs = 1;  // map points simulated at once
+  report::ProgressFn progress;  // the map's (MapSpec::progress)
   // where the CSV and the chart go (write_stability_files); empty: nothing
   std::string out_dir;
 };

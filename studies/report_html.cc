@@ -1,0 +1,403 @@
+#include "studies/report_html.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "report/svg_text.h"
+#include "studies/force_field_svg.h"
+
+namespace vmh::studies {
+namespace {
+
+using report::svg::escape;
+using Json = nlohmann::json;
+
+// a number as a reader reads it: 4 significant digits, integers whole
+std::string num(const Json& v) {
+  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
+  if (v.is_number_integer()) return std::to_string(v.get<long long>());
+  if (v.is_number()) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.4g", v.get<double>());
+    return buf;
+  }
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_null()) return "null";
+  if (v.is_array()) {
+    std::string s;
+    for (const Json& x : v) s += (s.empty() ? "" : ", ") + num(x);
+    return "(" + s + ")";
+  }
+  return v.dump();
+}
+
+// j[key] if j is an object holding it, else null
+const Json& at(const Json& j, const char* key) {
+  static const Json kNull;
+  if (!j.is_object()) return kNull;
+  const auto it = j.find(key);
+  return it == j.end() ? kNull : *it;
+}
+
+std::string td(const std::string& text, const std::string& cls = "") {
+  return (cls.empty() ? "<td>" : "<td class=\"" + cls + "\">") +
+         escape(text) + "</td>";
+}
+std::string th(const std::string& text) { return "<th>" + escape(text) + "</th>"; }
+
+// a figure, or a note where it is missing
+std::string figure(const std::string& svg, const std::string& caption) {
+  std::string s = "<figure>\n";
+  s += svg.empty() ? "<p class=\"note\">" + escape(caption) + ": not available</p>\n"
+                   : inline_svg(svg);
+  return s + "<figcaption>" + escape(caption) + "</figcaption>\n</figure>\n";
+}
+
+// a CSV as a table; the first line is the header
+std::string csv_table(const std::string& csv, const std::string& cls) {
+  std::istringstream in(csv);
+  std::string line, s = "<div class=\"scroll\"><table class=\"" + cls + "\">\n";
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    s += "<tr>";
+    std::istringstream cells(line);
+    std::string c;
+    while (std::getline(cells, c, ',')) {
+      if (header) {
+        s += th(c);
+      } else {
+        // numbers shortened; text as it is
+        char* end = nullptr;
+        const double v = std::strtod(c.c_str(), &end);
+        s += td(!c.empty() && end != nullptr && *end == '\0' ? num(Json(v)) : c);
+      }
+    }
+    s += "</tr>\n";
+    header = false;
+  }
+  return s + "</table></div>\n";
+}
+
+const char* const kStyle =
+    "body{font-family:sans-serif;margin:1.5em auto;max-width:1200px;"
+    "color:#222;padding:0 1em}"
+    "h1{font-size:1.6em}h2{border-bottom:2px solid #ccc;margin-top:2em}"
+    "table{border-collapse:collapse;margin:0.5em 0;font-size:0.9em}"
+    "td,th{border:1px solid #ccc;padding:2px 6px;text-align:left}"
+    "th{background:#f2f2f2}td.pass{background:#e6f4e6}"
+    "td.fail,tr.fail td{background:#fbd9d9;font-weight:bold;color:#900}"
+    "span.fail{color:#900;font-weight:bold}span.pass{color:#060}"
+    ".note{color:#775;font-style:italic}.scroll{overflow-x:auto}"
+    "figure{margin:1em 0}figcaption{font-size:0.85em;color:#555}"
+    "svg{max-width:100%;height:auto}img{max-width:100%}"
+    "details{margin:0.5em 0}";
+
+// the case's key parameters first, every one in a fold below
+std::string parameters(const Json& summary) {
+  const Json& params = at(summary, "parameters");
+  std::string s = "<table class=\"params\">\n<tr>" + th("parameter") +
+                  th("value") + th("unit") + th("source") + "</tr>\n";
+  const char* const key[] = {"vm_kind",        "vm_pivot_mm",     "vm_length_mm",
+                             "k_pos_N_per_mm", "k_ornt_multiple", "error",
+                             "servo_period_s", "duration_s"};
+  auto row = [&](const std::string& name, const Json& p) {
+    return "<tr>" + td(name) + td(num(at(p, "value"))) +
+           td(num(at(p, "unit"))) + td(num(at(p, "source"))) + "</tr>\n";
+  };
+  for (const char* k : key) {
+    if (!at(params, k).is_null()) s += row(k, at(params, k));
+  }
+  const Json& phys = at(summary, "physics");
+  s += "<tr>" + td("physics step_s, integrator") +
+       td(num(at(phys, "step_s")) + ", " + num(at(phys, "integrator"))) +
+       td("s") + td("scene") + "</tr>\n</table>\n";
+  if (params.is_object()) {
+    s += "<details><summary>every parameter</summary>\n<table class=\"params\">\n";
+    for (auto it = params.begin(); it != params.end(); ++it) s += row(it.key(), *it);
+    s += "</table></details>\n";
+  }
+  return s;
+}
+
+std::string claims_table(const Json& summary) {
+  std::string s = "<table class=\"claims\">\n<tr>" + th("claim") +
+                  th("value") + th("comparison") + th("threshold") +
+                  th("unit") + th("pass") + th("window") +
+                  th("mean distance off the path (mm)") + th("statement") +
+                  "</tr>\n";
+  for (const Json& c : at(summary, "claims")) {
+    const bool pass = at(c, "pass").is_boolean() && at(c, "pass").get<bool>();
+    s += std::string(pass ? "<tr class=\"pass\">" : "<tr class=\"fail\">") +
+         td(num(at(c, "name"))) + td(num(at(c, "value"))) +
+         td(num(at(c, "comparison"))) + td(num(at(c, "threshold"))) +
+         td(num(at(c, "unit"))) + td(pass ? "pass" : "FAIL", pass ? "pass" : "fail") +
+         td(num(at(c, "window"))) + td(num(at(c, "mean_path_distance_mm"))) +
+         td(num(at(c, "statement"))) + "</tr>\n";
+  }
+  return s + "</table>\n";
+}
+
+std::string case_section(const ReportCase& c) {
+  const Json& m = at(c.summary, "metrics");
+  std::string s = "<section id=\"" + escape(c.name) + "\">\n<h2>" +
+                  escape(c.name) + ": thesis case " +
+                  escape(num(at(c.summary, "thesis_case"))) + "</h2>\n";
+  s += "<p>" + escape("simulated " + num(at(c.summary, "simulated_s")) +
+                      " s in " + num(at(c.summary, "wall_time_s")) +
+                      " s wall; RMS distance from the path " +
+                      num(at(m, "rms_path_error_mm")) + " mm (max " +
+                      num(at(m, "max_path_error_mm")) + " mm); mean |F| " +
+                      num(at(m, "mean_force_N")) + " N (max " +
+                      num(at(m, "max_force_N")) + " N); scene " +
+                      num(at(c.summary, "scene"))) + "</p>\n";
+  s += "<h3>Parameters</h3>\n" + parameters(c.summary);
+  s += "<h3>Claims</h3>\n" + claims_table(c.summary);
+  s += "<h3>Figures</h3>\n";
+  s += figure(c.force_field_svg,
+              c.name + ": the commanded force along the RM wrist-centre "
+              "trajectory (device frame, mm)");
+  s += figure(c.views_svg, c.name + ": the RM off the path and on it "
+                           "(device frame, mm)");
+  s += figure(c.history_svg, c.name + ": error and force against time");
+  s += "<figure>\n";
+  if (c.render_png) {
+    s += "<img alt=\"" + escape(c.name) + " render\" src=\"data:image/png;base64," +
+         base64(*c.render_png) + "\"/>\n";
+  } else {
+    s += "<p class=\"note\">render unavailable: " +
+         escape(c.render_note.empty() ? "no renderer" : c.render_note) + "</p>\n";
+  }
+  s += "<figcaption>" + escape(c.name) + ": the scene</figcaption>\n</figure>\n";
+  return s + "</section>\n";
+}
+
+// error to the path against the run's cost, a row per case
+std::string run_time_table(const std::vector<ReportCase>& cases) {
+  std::string s = "<table class=\"runtime\">\n<tr>" + th("case") +
+                  th("simulated_s") + th("wall_time_s") +
+                  th("realtime_factor") + th("rms_path_error_mm") +
+                  th("max_path_error_mm") + th("rms_xv_error_mm") +
+                  th("claims passed") + "</tr>\n";
+  for (const ReportCase& c : cases) {
+    const Json& m = at(c.summary, "metrics");
+    int pass = 0, total = 0;
+    for (const Json& k : at(c.summary, "claims")) {
+      ++total;
+      pass += at(k, "pass").is_boolean() && at(k, "pass").get<bool>() ? 1 : 0;
+    }
+    s += std::string(pass == total ? "<tr>" : "<tr class=\"fail\">") +
+         td(c.name) + td(num(at(c.summary, "simulated_s"))) +
+         td(num(at(c.summary, "wall_time_s"))) +
+         td(num(at(c.summary, "realtime_factor"))) +
+         td(num(at(m, "rms_path_error_mm"))) +
+         td(num(at(m, "max_path_error_mm"))) +
+         td(num(at(m, "rms_xv_error_mm"))) +
+         td(std::to_string(pass) + "/" + std::to_string(total)) + "</tr>\n";
+  }
+  return s + "</table>\n";
+}
+
+std::string extremes_table(const Json& ex) {
+  std::string s = "<table class=\"extremes\">\n<tr>" + th("scenario") +
+                  th("stresses") + th("outcome") + th("pass") +
+                  th("max_force_N") + th("force_limit_N") +
+                  th("energy motor_max_J") + th("energy rest_rise_J") +
+                  th("wall_time_s") + "</tr>\n";
+  for (const Json& r : at(ex, "scenarios")) {
+    const bool pass = at(r, "pass").is_boolean() && at(r, "pass").get<bool>();
+    const Json& e = at(r, "energy");
+    s += std::string(pass ? "<tr>" : "<tr class=\"fail\">") +
+         td(num(at(r, "name"))) + td(num(at(r, "stresses"))) +
+         td(num(at(r, "outcome"))) +
+         td(pass ? "pass" : "FAIL", pass ? "pass" : "fail") +
+         td(num(at(r, "max_force_N"))) + td(num(at(r, "force_limit_N"))) +
+         td(num(at(e, "motor_max_J"))) + td(num(at(e, "rest_rise_J"))) +
+         td(num(at(r, "wall_time_s"))) + "</tr>\n";
+  }
+  return s + "</table>\n";
+}
+
+std::string list_text(const std::vector<std::string>& v) {
+  std::string s;
+  for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s.empty() ? "none" : s;
+}
+
+}  // namespace
+
+ReportCase load_report_case(const std::string& dir, const std::string& name,
+                            const RenderFn& render) {
+  namespace fs = std::filesystem;
+  auto read_text = [](const fs::path& p) { return read_file_text(p.string()); };
+  ReportCase c;
+  c.name = name;
+  const fs::path d = fs::path(dir) / name;
+  try {
+    c.summary = nlohmann::json::parse(read_text(d / "summary.json"));
+  } catch (const std::exception& e) {
+    throw std::runtime_error((d / "summary.json").string() + ": " + e.what());
+  }
+  c.views_svg = read_text(d / "views.svg");
+  c.history_svg = read_text(d / "history.svg");
+  ForceFieldPath path;
+  try {
+    const nlohmann::json& p = c.summary.at("parameters");
+    path.vm_kind = p.at("vm_kind").at("value").get<std::string>();
+    const auto pivot = p.at("vm_pivot_mm").at("value").get<std::vector<double>>();
+    for (std::size_t i = 0; i < 3 && i < pivot.size(); ++i) path.pivot_mm[i] = pivot[i];
+    path.length_mm = p.at("vm_length_mm").at("value").get<double>();
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error((d / "summary.json").string() +
+                             ": the VM's parameters: " + e.what());
+  }
+  try {
+    c.force_field_svg = force_field_svg(
+        force_samples_from_csv(read_text(d / "trace.csv")), path);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error((d / "trace.csv").string() + ": " + e.what());
+  }
+  std::string why;
+  if (render) {
+    c.render_png = render(name, c.summary.value("scene", ""), &why);
+  } else {
+    why = "no renderer in this build";
+  }
+  if (!c.render_png) c.render_note = why.empty() ? "the renderer gave none" : why;
+  return c;
+}
+
+std::string read_file_text(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return "";
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+ClaimTally tally_claims(const std::vector<ReportCase>& cases) {
+  ClaimTally t;
+  for (const ReportCase& c : cases) {
+    for (const Json& k : at(c.summary, "claims")) {
+      ++t.total;
+      if (at(k, "pass").is_boolean() && at(k, "pass").get<bool>()) {
+        ++t.passed;
+      } else {
+        t.failed.push_back(c.name + ":" + num(at(k, "name")));
+      }
+    }
+  }
+  return t;
+}
+
+std::string base64(const std::string& bytes) {
+  static const char* const kAlphabet =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const unsigned v = static_cast<unsigned char>(bytes[i]) << 16 |
+                       static_cast<unsigned char>(bytes[i + 1]) << 8 |
+                       static_cast<unsigned char>(bytes[i + 2]);
+    for (int k = 18; k >= 0; k -= 6) out += kAlphabet[(v >> k) & 63];
+  }
+  const std::size_t rest = bytes.size() - i;
+  if (rest > 0) {
+    unsigned v = static_cast<unsigned char>(bytes[i]) << 16;
+    if (rest == 2) v |= static_cast<unsigned char>(bytes[i + 1]) << 8;
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += rest == 2 ? kAlphabet[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+std::string inline_svg(const std::string& svg_document) {
+  const std::size_t start = svg_document.find("<svg");
+  return start == std::string::npos ? std::string() : svg_document.substr(start);
+}
+
+std::string report_html(const ReportInputs& in) {
+  const ReportHeader& h = in.header;
+  const ClaimTally tally = tally_claims(in.cases);
+  const bool all_pass = tally.passed == tally.total;
+  std::string s =
+      "<!DOCTYPE html>\n<html xmlns=\"http://www.w3.org/1999/xhtml\" "
+      "lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n"
+      "<title>vmhaptics report</title>\n<style>" +
+      std::string(kStyle) + "</style>\n</head>\n<body>\n";
+  s += "<h1>vmhaptics: virtual-mechanism control of the PHANTOM Omni, the "
+       "thesis's cases measured</h1>\n";
+  s += "<table class=\"header\">\n";
+  s += "<tr>" + th("software") + td("vmhaptics " + h.version) + "</tr>\n";
+  s += "<tr>" + th("git describe (at configure time)") + td(h.git_describe) + "</tr>\n";
+  s += "<tr>" + th("generated (UTC)") + td(h.generated_utc) + "</tr>\n";
+  s += "<tr>" + th("command line") + td(h.command_line) + "</tr>\n";
+  s += "<tr>" + th("cores") + td(std::to_string(h.cores)) + "</tr>\n";
+  s += "<tr>" + th("wall time (s)") + td(num(Json(h.wall_s))) + "</tr>\n";
+  s += "<tr>" + th("ran") + td(list_text(h.ran)) + "</tr>\n";
+  s += "<tr>" + th("reused from disk") + td(list_text(h.reused)) + "</tr>\n";
+  s += "</table>\n";
+  s += std::string("<p id=\"summary\" class=\"summary\">Claims passed: ") +
+       "<span class=\"" + (all_pass ? "pass" : "fail") + "\">" +
+       std::to_string(tally.passed) + "/" + std::to_string(tally.total) +
+       "</span>" +
+       (all_pass ? std::string()
+                 : " &#8212; failing: <span class=\"fail\">" +
+                       escape(list_text(tally.failed)) + "</span>") +
+       "</p>\n";
+  s += "<ul>\n";
+  for (const ReportCase& c : in.cases) {
+    s += "<li><a href=\"#" + escape(c.name) + "\">" + escape(c.name) + "</a></li>\n";
+  }
+  s += "<li><a href=\"#runtime\">error against run time</a></li>\n"
+       "<li><a href=\"#precision\">work-precision</a></li>\n"
+       "<li><a href=\"#stability\">stability map</a></li>\n"
+       "<li><a href=\"#extremes\">extreme scenarios</a></li>\n</ul>\n";
+
+  for (const ReportCase& c : in.cases) s += case_section(c);
+
+  const ReportStudies& st = in.studies;
+  s += "<section id=\"runtime\">\n<h2>Error against run time, per case</h2>\n" +
+       run_time_table(in.cases) + "</section>\n";
+  s += "<section id=\"precision\">\n<h2>Work-precision (" +
+       escape(st.precision_case.empty() ? "not run" : st.precision_case) +
+       ")</h2>\n";
+  s += figure(st.precision_svg, "trajectory error (RMS, mm) against wall "
+                                "time (s), per integrator and physics step");
+  s += figure(st.precision_order_svg, "trajectory error against the physics "
+                                      "step h, with the fitted orders");
+  if (!st.precision_csv.empty()) {
+    s += "<details><summary>every run (precision.csv)</summary>\n" +
+         csv_table(st.precision_csv, "precision") + "</details>\n";
+  }
+  s += "</section>\n";
+  s += "<section id=\"stability\">\n<h2>Stability map of the sampled-data "
+       "wall</h2>\n<p>" + escape(st.stability_note) + "</p>\n";
+  s += figure(st.stability_map_svg, "K_crit (N/m) against the virtual "
+                                    "damping B (N s/m), per delay");
+  if (!st.stability_map_csv.empty()) {
+    s += "<details><summary>the map (stability_map.csv)</summary>\n" +
+         csv_table(st.stability_map_csv, "stability") + "</details>\n";
+  }
+  s += "</section>\n";
+  s += "<section id=\"extremes\">\n<h2>Extreme scenarios</h2>\n";
+  if (st.extremes.is_null()) {
+    s += "<p class=\"note\">not run</p>\n";
+  } else {
+    s += extremes_table(st.extremes);
+  }
+  s += figure(st.extremes_svg, "the passivity observer's energy per scenario (mJ)");
+  s += "</section>\n";
+  s += "<p class=\"summary\">Claims passed: " + std::to_string(tally.passed) +
+       "/" + std::to_string(tally.total) + "</p>\n</body>\n</html>\n";
+  return s;
+}
+
+}  // namespace vmh::studies

@@ -1,0 +1,104 @@
+// `vmhaptics report` as a user runs it: --quick writes one self-contained
+// page and prints its JSON (about 20 s on two cores); a second run with
+// --reuse takes every case and study from the first one's files; bad
+// options are refused with exit 2 and one line.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/support/cli_run.h"
+#include "tests/support/svg_check.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using vmh::testing::run;
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+const std::vector<std::string> kCases = {"case1", "case2", "case3",
+                                         "case4", "case5", "case6"};
+
+TEST(ReportCliTest, QuickWritesThePageAndReuseTakesItsFiles) {
+  const fs::path dir = vmh::testing::fresh_dir("vmh_report_cli_", "quick");
+  const auto first = run("report --quick --out " + dir.string());
+  const json j = json::parse(first.out);
+  // 0 exactly when every claim passed; 1 otherwise, the page still written
+  EXPECT_EQ(first.exit_code,
+            j.at("claims_passed") == j.at("claims_total") ? 0 : 1)
+      << first.err;
+  EXPECT_EQ(j.at("report").get<std::string>(), (dir / "report.html").string());
+  EXPECT_EQ(j.at("cases").get<std::vector<std::string>>(), kCases);
+  EXPECT_GT(j.at("claims_total").get<int>(), 0);
+  EXPECT_TRUE(j.at("reused").empty());
+  for (const char* ran : {"case1", "case6", "extremes", "stability_map", "precision"}) {
+    EXPECT_NE(std::find(j.at("ran").begin(), j.at("ran").end(), ran),
+              j.at("ran").end()) << ran;
+  }
+  EXPECT_GT(j.at("wall_s").get<double>(), 0.0);
+  // the stderr bar is for terminals: none here
+  EXPECT_EQ(first.err.find('\r'), std::string::npos);
+
+  const std::string html = slurp(dir / "report.html");
+  EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
+  EXPECT_NE(html.find("</html>"), std::string::npos);
+  EXPECT_EQ(vmh::testing::count(html, "<svg"), vmh::testing::count(html, "</svg>"));
+  for (const std::string& c : kCases) {
+    EXPECT_NE(html.find("<section id=\"" + c + "\">"), std::string::npos) << c;
+    EXPECT_TRUE(fs::exists(dir / c / "summary.json")) << c;
+  }
+  for (const char* id : {"runtime", "precision", "stability", "extremes"}) {
+    EXPECT_NE(html.find(std::string("<section id=\"") + id + "\">"),
+              std::string::npos) << id;
+  }
+  for (const char* f : {"precision.svg", "stability_map.svg", "extremes.json"}) {
+    EXPECT_TRUE(fs::exists(dir / "study" / f)) << f;
+  }
+
+  const auto second = run("report --reuse --quick --out " + dir.string());
+  const json k = json::parse(second.out);
+  EXPECT_EQ(second.exit_code, first.exit_code) << second.err;
+  std::vector<std::string> reused_cases;
+  for (const json& r : k.at("reused")) {
+    const std::string name = r.get<std::string>();
+    if (name.rfind("case", 0) == 0) reused_cases.push_back(name);
+  }
+  EXPECT_EQ(reused_cases, kCases);
+  EXPECT_TRUE(k.at("ran").empty()) << k.dump();
+  EXPECT_EQ(k.at("claims_passed"), j.at("claims_passed"));
+}
+
+TEST(ReportCliTest, ReuseRunsOnlyWhatIsMissing) {
+  const fs::path dir = vmh::testing::fresh_dir("vmh_report_cli_", "partial");
+  // case 3 alone, as `run` writes it; the rest must run
+  ASSERT_EQ(run("run case3 --out " + dir.string()).exit_code, 0);
+  const auto r = run("report --reuse --quick --out " + dir.string());
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j.at("reused"), json::array({"case3"}));
+  EXPECT_EQ(j.at("ran").size(), 8u) << j.dump();
+}
+
+TEST(ReportCliTest, BadOptionsAreRefusedWithOneLine) {
+  for (const char* args : {"report --jobs -1", "report --jobs x",
+                           "report --out ''", "report --frobnicate"}) {
+    const auto r = run(args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_EQ(r.out, "") << args;
+    EXPECT_EQ(r.err.rfind("vmhaptics: error: ", 0), 0u) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
+}  // namespace
