@@ -160,7 +160,16 @@ void overlay_primitives(const VirtualMechanism& vm,
 }
 
 int add_overlay_to_scene(const std::vector<OverlayPrimitive>& prims,
-                         mjvScene* scn) {
+                         mjvScene* scn, float model_alpha) {
+  if (!prims.empty() && model_alpha < 1.0f) {
+    const float a = model_alpha < 0.0f ? 0.0f : model_alpha;
+    for (int i = 0; i < scn->ngeom; ++i) {
+      mjvGeom* g = scn->geoms + i;
+      if (g->category == mjCAT_DECOR) continue;
+      g->rgba[3] *= a;
+      g->transparent = 1;
+    }
+  }
   int added = 0;
   for (const OverlayPrimitive& p : prims) {
     if (scn->ngeom >= scn->maxgeom) break;

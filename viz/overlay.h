@@ -87,9 +87,16 @@ void overlay_primitives(const VirtualMechanism& vm,
 
 // Adds the primitives to the scene as mjvGeoms (lines and arrows as MuJoCo
 // connectors, points as spheres), after what mjv_updateScene put there.
-// Stops when the scene is full; returns how many were added.
+// The model's own geoms already in the scene are first made translucent
+// (their alpha times `model_alpha`, in [0, 1]; 1 leaves them alone): the
+// links, X(theta_V) and the force arrow mostly run inside the gimbal and
+// the stylus, where opaque bodies would hide them. Nothing is faded when
+// there are no primitives. Stops when the scene is full; returns how many
+// were added.
+inline constexpr float kOverlayModelAlpha = 0.35f;
 int add_overlay_to_scene(const std::vector<OverlayPrimitive>& prims,
-                         mjvScene* scn);
+                         mjvScene* scn,
+                         float model_alpha = kOverlayModelAlpha);
 
 }  // namespace vmh::viz
 

@@ -26,12 +26,14 @@ mjvCamera workspace_camera(const OmniParams& omni) {
   mjvCamera cam;
   mjv_defaultCamera(&cam);
   cam.type = mjCAMERA_FREE;
-  // halfway from the shoulder to the device-frame origin, world m
+  // near the device-frame origin (the thesis's VMs are pivoted there),
+  // pulled a little toward the shoulder, world m
   const Vec3 origin_m = device_mm_to_base(omni, Vec3::Zero());
-  for (int i = 0; i < 3; ++i) cam.lookat[i] = 0.6 * origin_m[i];
-  // 0.5 m shows the arm (two 0.13 m links) and a 50 mm circle with margin
-  // at MuJoCo's default 45 degree field of view
-  cam.distance = 0.5;
+  for (int i = 0; i < 3; ++i) cam.lookat[i] = 0.85 * origin_m[i];
+  // 0.33 m: the 100 mm circle or sphere fills about a third of the height
+  // at MuJoCo's default 45 degree field of view, with the forearm and the
+  // upper arm in the frame
+  cam.distance = 0.33;
   // azimuth 180 would look straight down -x (the device's -z); 160 turns
   // the view enough to show the arm's depth
   cam.azimuth = 160.0;

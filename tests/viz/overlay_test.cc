@@ -163,6 +163,24 @@ TEST(Overlay, SceneGeomsFollowMujocosConnectorConvention) {
   const Vec3 d = arrow_prim.b_m - arrow_prim.a_m;
   EXPECT_GT(z.dot(d.normalized()), 1.0 - 1e-5);
   EXPECT_NEAR(g.size[2], d.norm(), 1e-6);
+  // the model's geoms already there are faded, decorations are not
+  scn.ngeom = 2;
+  mjv_initGeom(&scn.geoms[0], mjGEOM_BOX, nullptr, nullptr, nullptr, nullptr);
+  scn.geoms[0].category = mjCAT_DYNAMIC;
+  scn.geoms[0].rgba[3] = 1.0f;
+  scn.geoms[0].transparent = 0;
+  mjv_initGeom(&scn.geoms[1], mjGEOM_BOX, nullptr, nullptr, nullptr, nullptr);
+  scn.geoms[1].category = mjCAT_DECOR;
+  scn.geoms[1].rgba[3] = 1.0f;
+  add_overlay_to_scene(prims, &scn, 0.25f);
+  EXPECT_FLOAT_EQ(scn.geoms[0].rgba[3], 0.25f);
+  EXPECT_EQ(scn.geoms[0].transparent, 1);
+  EXPECT_FLOAT_EQ(scn.geoms[1].rgba[3], 1.0f);
+  // with nothing to draw the model is left alone
+  scn.ngeom = 1;
+  scn.geoms[0].rgba[3] = 1.0f;
+  add_overlay_to_scene({}, &scn, 0.25f);
+  EXPECT_FLOAT_EQ(scn.geoms[0].rgba[3], 1.0f);
   // a full scene takes no more
   scn.ngeom = 62;
   EXPECT_EQ(add_overlay_to_scene(prims, &scn), 2);
