@@ -63,6 +63,19 @@ TEST(ReportCliTest, QuickWritesThePageAndReuseTakesItsFiles) {
     EXPECT_NE(html.find(std::string("<section id=\"") + id + "\">"),
               std::string::npos) << id;
   }
+  // one render per case, inline: "iVBORw0KGgo" is the base64 of the PNG
+  // signature. Registered under Xvfb where the build has the renderer
+  // (VMH_EXPECT_RENDERS); elsewhere each case must say why it has none.
+#ifdef VMH_EXPECT_RENDERS
+  EXPECT_EQ(vmh::testing::count(html, "src=\"data:image/png;base64,iVBORw0KGgo"),
+            6) << first.err;
+  EXPECT_EQ(html.find("render unavailable"), std::string::npos);
+  for (const std::string& c : kCases) {
+    EXPECT_FALSE(fs::is_empty(dir / c / "render")) << c;
+  }
+#else
+  EXPECT_EQ(vmh::testing::count(html, "render unavailable: "), 6);
+#endif
   for (const char* f : {"precision.svg", "stability_map.svg", "extremes.json"}) {
     EXPECT_TRUE(fs::exists(dir / "study" / f)) << f;
   }
