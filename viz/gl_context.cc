@@ -20,7 +20,9 @@ void on_glfw_error(int code, const char* text) {
                  (text != nullptr ? text : "(no text)");
 }
 
-std::string take_error() {
+}  // namespace
+
+std::string take_glfw_error() {
   std::lock_guard<std::mutex> lock(g_mutex);
   std::string e = g_last_error.empty() ? std::string("no GLFW error text")
                                        : g_last_error;
@@ -28,8 +30,6 @@ std::string take_error() {
   return e;
 }
 
-// glfwInit once per process; glfwTerminate is left to process exit, as
-// another context (the viewer's) may still be open
 bool init_glfw_once(std::string* error) {
   static std::once_flag once;
   static bool ok = false;
@@ -37,11 +37,13 @@ bool init_glfw_once(std::string* error) {
   std::call_once(once, [] {
     glfwSetErrorCallback(on_glfw_error);
     ok = glfwInit() == GLFW_TRUE;
-    if (!ok) init_error = take_error();
+    if (!ok) init_error = take_glfw_error();
   });
   if (!ok) *error = init_error;
   return ok;
 }
+
+namespace {
 
 const char* const kNoContext =
     "no OpenGL context: GLFW could not open a window (no X display? run "
@@ -62,7 +64,7 @@ GlContext::GlContext(int width_px, int height_px) {
                              nullptr, nullptr);
   glfwDefaultWindowHints();
   if (window_ == nullptr) {
-    throw std::runtime_error(std::string(kNoContext) + ": " + take_error());
+    throw std::runtime_error(std::string(kNoContext) + ": " + take_glfw_error());
   }
   glfwMakeContextCurrent(window_);
 }

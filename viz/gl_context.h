@@ -7,7 +7,18 @@
 
 struct GLFWwindow;
 
+#include <string>
+
 namespace vmh::viz {
+
+// GLFW for the whole process, shared by the renderer's hidden windows and
+// the viewer's window: glfwInit once, with one error callback, and never
+// glfwTerminate (that would close every other window of the process).
+// Returns false with GLFW's own text in *error when there is no display.
+bool init_glfw_once(std::string* error);
+// the last error GLFW reported since the previous call ("no GLFW error
+// text" if none), cleared
+std::string take_glfw_error();
 
 class GlContext {
  public:

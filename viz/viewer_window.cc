@@ -4,21 +4,10 @@
 
 #include <string>
 
+#include "viz/gl_context.h"
+
 namespace vmh::viz {
 namespace {
-
-// GLFW reports its errors through a callback; the last one names the cause
-// when glfwInit or glfwCreateWindow fails (e.g. "X11: The DISPLAY
-// environment variable is missing")
-std::string& last_glfw_error() {
-  static std::string text;
-  return text;
-}
-
-void on_glfw_error(int code, const char* text) {
-  last_glfw_error() = std::string(text ? text : "unknown") + " (GLFW error " +
-                      std::to_string(code) + ")";
-}
 
 Viewer* owner_of(GLFWwindow* w) {
   return static_cast<Viewer*>(glfwGetWindowUserPointer(w));
@@ -60,17 +49,17 @@ void on_scroll(GLFWwindow* w, double /*dx*/, double dy) {
 
 Viewer::Window::Window(int width_px, int height_px, const char* title,
                        Viewer* owner) {
-  glfwSetErrorCallback(on_glfw_error);
-  last_glfw_error().clear();
-  if (glfwInit() != GLFW_TRUE) {
-    throw ViewerError("cannot open a window: GLFW: " + last_glfw_error());
+  // GLFW is the process's, shared with the renderer (viz/gl_context.h)
+  std::string why;
+  if (!init_glfw_once(&why)) {
+    throw ViewerError("cannot open a window: " + why);
   }
+  take_glfw_error();  // only what this window's creation reports
   glfwWindowHint(GLFW_SAMPLES, 0);
   glfw = glfwCreateWindow(width_px, height_px, title, nullptr, nullptr);
+  glfwDefaultWindowHints();
   if (glfw == nullptr) {
-    const std::string why = last_glfw_error();
-    glfwTerminate();
-    throw ViewerError("cannot open a window: GLFW: " + why);
+    throw ViewerError("cannot open a window: " + take_glfw_error());
   }
   glfwMakeContextCurrent(glfw);
   glfwSwapInterval(1);  // at the display's rate, not as fast as possible
@@ -82,8 +71,8 @@ Viewer::Window::Window(int width_px, int height_px, const char* title,
 }
 
 Viewer::Window::~Window() {
+  if (glfwGetCurrentContext() == glfw) glfwMakeContextCurrent(nullptr);
   glfwDestroyWindow(glfw);
-  glfwTerminate();
 }
 
 bool Viewer::Window::should_close() const {

@@ -1,5 +1,6 @@
 // `vmhaptics view` from the command line, under Xvfb: a short scripted run
-// exits 0 and says how many frames it drew; a bad case is a usage error.
+// exits 0 and says how many frames it drew; a bad case is a usage error;
+// without a display it says so.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -13,8 +14,10 @@ struct Result {
   std::string err;
 };
 
-Result run(const std::string& args) {
-  const std::string cmd = std::string(VMH_CLI_PATH) + " " + args + " 2>&1";
+// `env_prefix` runs the program under e.g. "env -u DISPLAY "
+Result run(const std::string& args, const std::string& env_prefix = "") {
+  const std::string cmd =
+      env_prefix + std::string(VMH_CLI_PATH) + " " + args + " 2>&1";
   Result r;
   FILE* p = popen(cmd.c_str(), "r");
   if (p == nullptr) return r;
@@ -42,6 +45,17 @@ TEST(ViewCli, EmulatorDeviceShowsItsState) {
   const Result r =
       run("view case1 --device emulator --frames 20 --width 320 --height 240");
   EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("20 frames"), std::string::npos) << r.err;
+}
+
+// without a display: exit 1 and GLFW's own reason, on one line
+TEST(ViewCli, NoDisplayIsExit1NamingIt) {
+  const Result r = run("view case1 --frames 3", "env -u DISPLAY -u WAYLAND_DISPLAY ");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("vmhaptics: error: view: cannot open a window"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("DISPLAY"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
 }
 
 }  // namespace
