@@ -1,7 +1,6 @@
 #include "cli/hw_common.h"
 
 #include <csignal>
-#include <ctime>
 
 #include "cli/args.h"
 #include "report/output_file.h"
@@ -121,15 +120,6 @@ Json session_json(const SessionResult& r) {
                     {"memory_locked", r.servo_report.memory_locked},
                     {"note", r.servo_report.note}}},
               {"timing", timing_json(r.timing)}};
-}
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
 }
 
 Json meta_json(const OpenedDevice& dev, const SessionResult& r,

@@ -52,9 +52,6 @@ Json session_json(const SessionResult& r);
 Json meta_json(const OpenedDevice& dev, const SessionResult& r,
                const std::string& verb, const Json& extra);
 
-// now, UTC, ISO 8601 to the second ("2026-11-23T16:04:02Z")
-std::string utc_now();
-
 // Writes out_dir/meta.json (atomically); nothing when out_dir is empty
 void write_meta(const std::string& out_dir, const Json& meta);
 

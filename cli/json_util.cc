@@ -1,5 +1,7 @@
 #include "cli/json_util.h"
 
+#include <ctime>
+
 namespace vmh::cli {
 
 namespace {
@@ -58,6 +60,15 @@ std::string dump_readable(const Json& j) {
   std::string out;
   write(j, 0, &out);
   return out;
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
 }
 
 }  // namespace vmh::cli

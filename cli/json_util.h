@@ -1,4 +1,5 @@
-// Eigen values as JSON arrays: vectors as lists, matrices as lists of rows.
+// Eigen values as JSON arrays: vectors as lists, matrices as lists of rows;
+// the time stamp the outputs carry.
 #ifndef VMHAPTICS_CLI_JSON_UTIL_H_
 #define VMHAPTICS_CLI_JSON_UTIL_H_
 
@@ -14,6 +15,10 @@ using Json = nlohmann::ordered_json;
 // JSON text for people and programs alike: one key per line, and arrays of
 // numbers (or of rows of numbers) on one line each.
 std::string dump_readable(const Json& j);
+
+// now, UTC, ISO 8601 to the second ("2026-11-23T16:04:02Z"): the date_utc
+// of meta.json, of stored calibrations and of the report's header
+std::string utc_now();
 
 template <typename Derived>
 Json to_json_vector(const Eigen::MatrixBase<Derived>& v) {

@@ -10,7 +10,6 @@
 // Exit codes: 0 written and every claim passed; 1 a claim failed (the page
 // is still written) or a run failed; 2 bad usage.
 #include <chrono>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -23,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/args.h"
+#include "cli/json_util.h"
 #include "report/output_file.h"
 #include "report/parallel.h"
 #include "report/progress.h"
@@ -119,15 +119,6 @@ bool all_exist(const fs::path& dir, std::initializer_list<const char*> names) {
     if (!fs::is_regular_file(dir / n, ec)) return false;
   }
   return true;
-}
-
-std::string utc_now_iso() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
 }
 
 std::string command_line(const ReportCli& o) {
@@ -291,7 +282,7 @@ void run(const ReportCli& o) {
   studies::ReportHeader& h = in.header;
   h.version = VMH_VERSION;
   h.git_describe = VMH_GIT_DESCRIBE;
-  h.generated_utc = utc_now_iso();
+  h.generated_utc = utc_now();
   h.command_line = command_line(o);
   h.cores = report::core_count();
   h.reused = reused;
