@@ -89,18 +89,26 @@ void Progress::update_locked(std::size_t k, std::size_t done,
   draw_locked(false);
 }
 
-std::size_t Progress::done() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+std::size_t Progress::done_locked() const {
   std::size_t s = 0;
   for (std::size_t d : done_) s += d;
   return s;
 }
 
-std::size_t Progress::total() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+std::size_t Progress::total_locked() const {
   std::size_t s = 0;
   for (std::size_t t : total_) s += t;
   return s;
+}
+
+std::size_t Progress::done() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return done_locked();
+}
+
+std::size_t Progress::total() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return total_locked();
 }
 
 void Progress::finish() {
@@ -116,9 +124,8 @@ void Progress::finish() {
 
 void Progress::draw_locked(bool force) {
   if (out_ == nullptr || finished_) return;
-  std::size_t done = 0, total = 0;
-  for (std::size_t d : done_) done += d;
-  for (std::size_t t : total_) total += t;
+  const std::size_t done = done_locked();
+  const std::size_t total = total_locked();
   const double now = clock_();
   if (!force && done < total && drew_ &&
       now - last_draw_s_ < kRedrawInterval_s) {

@@ -63,6 +63,9 @@ class Progress {
  private:
   void update_locked(std::size_t k, std::size_t done, std::size_t total);
   void draw_locked(bool force);
+  // the parts' done and total summed (mutex_ held)
+  std::size_t done_locked() const;
+  std::size_t total_locked() const;
 
   std::string label_;
   std::ostream* out_;  // null: silent

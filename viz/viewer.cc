@@ -105,6 +105,11 @@ void Viewer::build_case() {
   sim_->set_paused(was_paused);
   const mjModel* m = sim_->model();
   d_render_ = mj_makeData(m);
+  for (int i = 0; i < 6; ++i) {
+    const std::string name = "q" + std::to_string(i + 1);
+    const int j = mj_name2id(m, mjOBJ_JOINT, name.c_str());
+    qpos_adr_[static_cast<std::size_t>(i)] = j >= 0 ? m->jnt_qposadr[j] : -1;
+  }
   if (scene_made_) {
     mjr_freeContext(&con_);
     mjv_freeScene(&scn_);
@@ -127,9 +132,8 @@ void Viewer::copy_from_physics() {
     if (!s.valid) return;
     const Joints q_dh = device_to_dh_joints(s.q_device_rad);
     for (int i = 0; i < 6; ++i) {
-      const std::string name = "q" + std::to_string(i + 1);
-      const int j = mj_name2id(m, mjOBJ_JOINT, name.c_str());
-      if (j >= 0) d_render_->qpos[m->jnt_qposadr[j]] = q_dh[i];
+      const int adr = qpos_adr_[static_cast<std::size_t>(i)];
+      if (adr >= 0) d_render_->qpos[adr] = q_dh[i];
     }
     mj_forward(m, d_render_);
     out_ = s.out;

@@ -175,6 +175,9 @@ class Viewer {
   // the physics, and the render thread's copy of it
   std::unique_ptr<SimThread> sim_;
   mjData* d_render_ = nullptr;
+  // qpos address of the model's joints q1..q6 (-1 where missing), for
+  // posing it from a live device's reading
+  std::array<int, 6> qpos_adr_{-1, -1, -1, -1, -1, -1};
   std::unique_ptr<Controller> overlay_controller_;  // its mechanism, drawn
   ControlOutput out_;
   double t_sim_s_ = 0.0;
