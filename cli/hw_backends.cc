@@ -175,11 +175,13 @@ DeviceSpec parse_device_spec(const std::string& text) {
   const auto colon = text.find(':');
   s.backend = text.substr(0, colon);
   if (colon != std::string::npos) s.argument = text.substr(colon + 1);
-  if (s.backend != "emulator" && s.backend != "openhaptics") {
+  if (s.backend != "emulator" && s.backend != "openhaptics" &&
+      s.backend != "firewire" && s.backend != "usb") {
     throw UsageError("--device: unknown backend '" + s.backend +
-                     "' (expected emulator[:case|scene.xml] or "
-                     "openhaptics[:CONFIG_NAME]; `vmhaptics hw list` shows "
-                     "what is available)");
+                     "' (expected emulator[:firewire][:case|scene.xml], "
+                     "openhaptics[:CONFIG_NAME], firewire[:GUID] or "
+                     "usb[:BUS-ADDR]; `vmhaptics hw list` shows what is "
+                     "available)");
   }
   return s;
 }

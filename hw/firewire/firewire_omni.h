@@ -1,0 +1,150 @@
+// The FireWire PHANTOM Omni as a HapticDevice and a DeviceBackend
+// (`--device firewire[:GUID]`, and `--device emulator:firewire` over the
+// emulator's in-process transport). Layers, as libnifalcon and libuvc have
+// them:
+//   transport (transport.h)   moves the packets: libraw1394, or in process
+//   codec (omni_packet.h)     bytes <-> typed fields, pure functions
+//   device (this file)        calibration (hw/omni_calibration.h), units,
+//                             the device convention, lost-packet and
+//                             bus-reset handling; the servo thread
+//
+// read_state(): one receive() (at most options.receive_timeout_s), decoded
+// to encoder counts (unwrapped from int16 to int32 across packets), pot
+// codes (pot_code of the a/b words), buttons, the inkwell switch and a
+// CLOCK_MONOTONIC timestamp; then angles_from_raw() with the calibration.
+// Fills kStateJoints | kStateButtons | kStateInkwell | kStateTimestamp |
+// kStateEncoders | kStatePots. Maps TransportStatus to DeviceError:
+// kTimeout -> kTimeout, kBusReset -> recover() then kNotConnected for this
+// tick (the encoder unwrap is re-seeded from the next packet),
+// kDisconnected -> kNotConnected, kIo / kBadPacket -> kIo. A pot that reads
+// open (a + b = 0) is kSensorFault.
+//
+// write_motor_torques(): per motor u = motor_sign * tau / full_scale_Nm,
+// saturated to [-1, 1] by the codec; a non-finite torque sends zero words
+// with the motors off and returns kInvalidCommand. The motors-on bit is set
+// from the first finite write; stop sends zero words with it cleared.
+//
+// NOT VERIFIED ON A DEVICE (docs/hardware.md): the packet layout, the
+// motor word's sign and full scale (kMotorFullScaleEstimate_Nm), the
+// direction each encoder counts (hw::kEncoderSign).
+#ifndef VMHAPTICS_HW_FIREWIRE_FIREWIRE_OMNI_H_
+#define VMHAPTICS_HW_FIREWIRE_FIREWIRE_OMNI_H_
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+
+#include "device/device_backend.h"
+#include "device/haptic_device.h"
+#include "device/seqlock.h"
+#include "hw/firewire/omni_packet.h"
+#include "hw/firewire/transport.h"
+#include "hw/omni_calibration.h"
+
+namespace vmh {
+class ServoThread;
+}
+
+namespace vmh::hw::fw {
+
+// Torque on a motor's joint at full-scale command u = +-1, N m: an
+// ESTIMATE (no public source gives the DAC's scale). It is the largest of
+// OpenHaptics's sample torque clamps (docs/sources.md §7), so that no clamp
+// the safety layer applies is cut by the codec. To be measured on a device
+// (hw motor-test, then identify).
+inline constexpr double kMotorFullScaleEstimate_Nm = 0.35;
+
+struct FirewireOmniOptions {
+  OmniCalibration calibration;  // how raw readings become angles
+  // torque at u = +1 per motor t1..t3, N m (> 0, finite)
+  std::array<double, 3> full_scale_Nm{kMotorFullScaleEstimate_Nm,
+                                      kMotorFullScaleEstimate_Nm,
+                                      kMotorFullScaleEstimate_Nm};
+  // +1 or -1: the sign of u for a positive device-convention torque
+  std::array<int, 3> motor_sign{+1, +1, +1};
+  double receive_timeout_s = 2e-3;  // per read_state (> 0)
+  // Throws std::invalid_argument naming the bad field.
+  void validate() const;
+};
+
+// What the device layer counted (safe to read from any thread).
+struct FirewireOmniStats {
+  std::uint64_t packets = 0;        // state packets decoded
+  std::uint64_t lost_packets = 0;   // counter gaps between decoded packets
+  std::uint64_t bad_packets = 0;    // refused by the codec or the transport
+  std::uint64_t timeouts = 0;
+  std::uint64_t bus_resets = 0;
+  std::uint64_t recoveries_failed = 0;
+  std::uint64_t commands = 0;       // command packets sent
+  std::uint64_t saturated_commands = 0;  // a |u| > 1 was cut to 1
+  std::uint32_t last_counter = 0;
+};
+
+class FirewireOmni final : public HapticDevice {
+ public:
+  // The transport is not owned and must outlive the device. Validates the
+  // options (std::invalid_argument naming the field).
+  FirewireOmni(Transport* transport, const FirewireOmniOptions& options);
+
+  DeviceError read_joints(Joints* q_device_rad) noexcept override;
+  DeviceError read_state(DeviceState* state) noexcept override;
+  DeviceError write_motor_torques(const Vec3& tau_motor_Nm) noexcept override;
+
+  // zero words, motors off (stop, faults)
+  DeviceError send_zero() noexcept;
+
+  // from any thread (validated; throws std::invalid_argument)
+  void set_calibration(const OmniCalibration& cal);
+  OmniCalibration calibration() const noexcept { return cal_.read(); }
+  FirewireOmniStats stats() const noexcept { return stats_.read(); }
+  // the last decoded packet (for `hw probe`)
+  StatePacket last_packet() const noexcept { return last_.read(); }
+
+ private:
+  Transport* transport_;
+  FirewireOmniOptions options_;
+  Seqlock<OmniCalibration> cal_;
+  Seqlock<FirewireOmniStats> stats_;
+  Seqlock<StatePacket> last_;
+  // servo thread's own
+  FirewireOmniStats s_;
+  bool have_counts_ = false;
+  std::array<std::int32_t, 3> counts_{};
+  bool have_counter_ = false;
+  bool motors_on_ = false;
+};
+
+// The backend: owns the transport and the device, runs the loop on the
+// project's ServoThread (device/servo_thread.h).
+class FirewireBackend final : public DeviceBackend {
+ public:
+  // `identity` fills what the transport does not know (backend name,
+  // config). Throws std::invalid_argument for bad options.
+  FirewireBackend(std::unique_ptr<Transport> transport,
+                  const FirewireOmniOptions& options,
+                  DeviceIdentity identity);
+  ~FirewireBackend() override;
+
+  DeviceIdentity identity() const override;
+  CalibrationState calibration_state() override;
+  HapticDevice* device() noexcept override { return &omni_; }
+  ServoReport start(ServoLoop* loop, const ServoOptions& options) override;
+  void stop() noexcept override;
+  bool running() const noexcept override;
+  TickStats timing() const override;
+
+  FirewireOmni* omni() noexcept { return &omni_; }
+  Transport* transport() noexcept { return transport_.get(); }
+
+ private:
+  std::unique_ptr<Transport> transport_;
+  FirewireOmni omni_;
+  DeviceIdentity identity_;
+  std::unique_ptr<ServoThread> thread_;
+  bool started_ = false;
+};
+
+}  // namespace vmh::hw::fw
+
+#endif  // VMHAPTICS_HW_FIREWIRE_FIREWIRE_OMNI_H_
