@@ -32,6 +32,7 @@
 
 #include <array>
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -55,8 +56,27 @@ namespace vmh::hw::fw {
 // (hw motor-test, then identify).
 inline constexpr double kMotorFullScaleEstimate_Nm = 0.35;
 
+// A calibration to start from before `hw calibrate` has fitted the unit's
+// own: encoder offsets zero (angles relative to where the counters started)
+// and every gimbal pot on §9.2's example line theta = 5.48 r - 2.74 rad with
+// r = code / kPotCodeMax. The pot constants differ per unit (§9.2): angles
+// read through this are rough; calibration_state() says kNeedsUpdate.
+inline OmniCalibration nominal_calibration() {
+  OmniCalibration c;
+  for (std::size_t i = 0; i < 3; ++i) {
+    c.encoder_offset_rad[i] = 0.0;
+    c.pot_gain_rad[i] = 5.48 / kPotCodeMax;
+    c.pot_offset_rad[i] = -2.74;
+  }
+  return c;
+}
+
 struct FirewireOmniOptions {
-  OmniCalibration calibration;  // how raw readings become angles
+  // how raw readings become angles
+  OmniCalibration calibration = nominal_calibration();
+  // true when `calibration` is this unit's own (a stored `hw calibrate`
+  // fit); calibration_state() is then kOk, else kNeedsUpdate
+  bool calibrated = false;
   // torque at u = +1 per motor t1..t3, N m (> 0, finite)
   std::array<double, 3> full_scale_Nm{kMotorFullScaleEstimate_Nm,
                                       kMotorFullScaleEstimate_Nm,
@@ -94,8 +114,12 @@ class FirewireOmni final : public HapticDevice {
   // zero words, motors off (stop, faults)
   DeviceError send_zero() noexcept;
 
-  // from any thread (validated; throws std::invalid_argument)
+  // from one thread at a time, any thread (validated; throws
+  // std::invalid_argument); marks the device calibrated
   void set_calibration(const OmniCalibration& cal);
+  bool calibrated() const noexcept {
+    return calibrated_.load(std::memory_order_acquire);
+  }
   OmniCalibration calibration() const noexcept { return cal_.read(); }
   FirewireOmniStats stats() const noexcept { return stats_.read(); }
   // the last decoded packet (for `hw probe`)
@@ -107,12 +131,18 @@ class FirewireOmni final : public HapticDevice {
   Seqlock<OmniCalibration> cal_;
   Seqlock<FirewireOmniStats> stats_;
   Seqlock<StatePacket> last_;
+  std::atomic<bool> calibrated_{false};
   // servo thread's own
+  std::array<std::uint8_t, 64> rx_{};  // one received packet (> 44 bytes, so
+                                       // a long one arrives whole)
   FirewireOmniStats s_;
   bool have_counts_ = false;
   std::array<std::int32_t, 3> counts_{};
   bool have_counter_ = false;
   bool motors_on_ = false;
+
+  DeviceError send_command(const CommandPacket& c) noexcept;
+  void publish() noexcept { stats_.write(s_); }
 };
 
 // The backend: owns the transport and the device, runs the loop on the
