@@ -157,7 +157,7 @@ void encode_command(const CommandPacket& p,
 // §9.2 gives word = (u + 1)/2 * 4095, whose zero falls between two words
 // (2047.5). Here zero is exactly kMotorWordZero and each half of the range
 // is scaled to reach its end (-1 -> 0x0000, +1 -> 0x0fff), which is within
-// half a count of the source's line everywhere and inverts exactly.
+// one count of the source's line everywhere and inverts exactly.
 std::uint16_t motor_word_from_unit(double u) noexcept {
   if (std::isnan(u)) return kMotorWordZero;
   if (u >= 1.0) return kMotorWordMax;  // also +inf

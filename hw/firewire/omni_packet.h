@@ -107,7 +107,7 @@ void encode_command(const CommandPacket& p,
 // u in [-1, 1] -> motor word. Out-of-range u, +-inf included, saturates at
 // 0x0000 / 0x0fff (never wraps); NaN gives kMotorWordZero. Zero is exactly
 // 0x07ff and each half-range is scaled to reach its end (2047 words below
-// zero, 2048 above): within half a word of the sources' (u+1)/2*4095, and
+// zero, 2048 above): within one word of the sources' (u+1)/2*4095, and
 // unit_from_motor_word inverts it exactly on every word.
 std::uint16_t motor_word_from_unit(double u) noexcept;
 // motor word -> u (0x07ff -> 0 exactly, 0x0000 -> -1, 0x0fff -> +1; bits
