@@ -1,0 +1,317 @@
+#include "hw/usb/touch_usb.h"
+
+#include <libusb.h>
+
+#include <chrono>
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <cstdio>
+#include <ctime>
+#include <memory>
+
+#include "hw/usb/usb_transport.h"
+
+namespace vmh::hw::usb {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string describe(const UsbDeviceInfo& d) {
+  return format_usb_id(d.vendor_id, d.product_id) + " at bus " + std::to_string(d.bus) +
+         " address " + std::to_string(d.address);
+}
+
+std::string open_failure(int error, const UsbDeviceInfo& d) {
+  const std::string node = usbfs_path({d.bus, d.address});
+  if (error == LIBUSB_ERROR_ACCESS) {
+    return "permission denied opening " + node +
+           ": install hw/udev/60-vmhaptics.rules (hw/udev/README.md, "
+           "docs/hardware.md)";
+  }
+  return "could not open " + node + ": " + usb_error_text(error);
+}
+
+TouchListing listing(const UsbDeviceInfo& d, int open_error) {
+  TouchListing t;
+  t.id = format_usb_id(d.vendor_id, d.product_id);
+  t.bus = d.bus;
+  t.address = d.address;
+  t.port_path = d.port_path;
+  t.accessible = open_error == 0;
+  if (!t.accessible) t.why_not = open_failure(open_error, d);
+  return t;
+}
+
+// the device at `where` (must be a Touch), or the first Touch
+const UsbDeviceInfo& select_touch(const UsbDeviceList& list,
+                                  const std::optional<BusAddress>& where) {
+  if (where) {
+    for (const UsbDeviceInfo& d : list.devices()) {
+      if (d.bus != where->bus || d.address != where->address) continue;
+      if (!is_touch_id(d.vendor_id, d.product_id)) {
+        throw UsbUsageError("--device usb:" + std::to_string(where->bus) + "-" +
+                            std::to_string(where->address) + ": the device there is " +
+                            format_usb_id(d.vendor_id, d.product_id) +
+                            ", not a Touch (`vmhaptics hw list`)");
+      }
+      return d;
+    }
+    throw UsbUsageError("--device usb:" + std::to_string(where->bus) + "-" +
+                        std::to_string(where->address) + ": no USB device at bus " +
+                        std::to_string(where->bus) + " address " +
+                        std::to_string(where->address) + " (`vmhaptics hw list`)");
+  }
+  for (const UsbDeviceInfo& d : list.devices()) {
+    if (is_touch_id(d.vendor_id, d.product_id)) return d;
+  }
+  throw UsbUsageError("--device usb: no USB Touch found (looked for 2988:0301, "
+                      "2988:0302, 2988:0304 and 0301:2988)");
+}
+
+UsbDescriptors read_descriptors(const UsbDeviceInfo& d) {
+  const std::vector<std::uint8_t> raw = sysfs_descriptors(d.port_path);
+  if (raw.empty()) {
+    throw UsbDeviceError("could not read the descriptors of " + describe(d) + " from " +
+                         sysfs_device_dir(d.port_path) + "/descriptors");
+  }
+  try {
+    return parse_usb_descriptors(raw);
+  } catch (const std::invalid_argument& e) {
+    throw UsbDeviceError(describe(d) + ": " + e.what());
+  }
+}
+
+int active_configuration(const UsbDeviceInfo& d, const UsbDescriptors& desc) {
+  bool found = false;
+  const std::string v = sysfs_attribute(d.port_path, "bConfigurationValue", &found);
+  if (found && !v.empty()) return std::atoi(v.c_str());
+  return desc.configurations.empty() ? 0 : desc.configurations.front().value;
+}
+
+const UsbConfiguration* find_configuration(const UsbDescriptors& desc, int value) {
+  for (const UsbConfiguration& c : desc.configurations) {
+    if (c.value == value) return &c;
+  }
+  return nullptr;
+}
+
+// sysfs first (the kernel read it at enumeration; no permission needed),
+// then the device itself
+UsbStringReport read_string(const UsbDeviceInfo& d, UsbHandle* handle,
+                            const std::string& attribute, std::uint8_t index,
+                            const std::string& open_why_not) {
+  UsbStringReport s;
+  s.index = index;
+  if (index == 0) {
+    s.why_not = "the device has no such string (index 0)";
+    return s;
+  }
+  bool found = false;
+  const std::string v = sysfs_attribute(d.port_path, attribute, &found);
+  if (found) {
+    s.value = v;
+    s.source = "sysfs";
+    return s;
+  }
+  if (handle == nullptr || !handle->is_open()) {
+    s.why_not = "not in sysfs, and the device could not be opened: " + open_why_not;
+    return s;
+  }
+  std::string why;
+  s.value = read_string_descriptor(handle, index, &why);
+  if (s.value) {
+    s.source = "device";
+  } else {
+    s.why_not = "not in sysfs; " + why;
+  }
+  return s;
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+struct FileCloser {
+  void operator()(std::FILE* f) const {
+    if (f != nullptr) std::fclose(f);
+  }
+};
+
+}  // namespace
+
+TouchScan list_touch_devices() {
+  TouchScan scan;
+  try {
+    UsbContext ctx;
+    UsbDeviceList list(ctx);
+    for (const UsbDeviceInfo& d : list.devices()) {
+      if (!is_touch_id(d.vendor_id, d.product_id)) continue;
+      int error = 0;
+      UsbHandle handle(d.device, &error);
+      scan.found.push_back(listing(d, error));
+    }
+  } catch (const UsbDeviceError& e) {
+    scan.found.clear();
+    scan.why_none = e.what();
+  }
+  return scan;
+}
+
+TouchProbe probe_touch(const std::optional<BusAddress>& where) {
+  UsbContext ctx;
+  UsbDeviceList list(ctx);
+  const UsbDeviceInfo& d = select_touch(list, where);
+  TouchProbe p;
+  int error = 0;
+  UsbHandle handle(d.device, &error);
+  p.device = listing(d, error);
+  p.descriptors = read_descriptors(d);
+  p.active_configuration = active_configuration(d, p.descriptors);
+  const UsbDeviceDescriptor& dd = p.descriptors.device;
+  p.manufacturer = read_string(d, &handle, "manufacturer", dd.manufacturer_index, p.device.why_not);
+  p.product = read_string(d, &handle, "product", dd.product_index, p.device.why_not);
+  p.serial = read_string(d, &handle, "serial", dd.serial_index, p.device.why_not);
+  if (const UsbConfiguration* c = find_configuration(p.descriptors, p.active_configuration)) {
+    for (const UsbInterface& i : c->interfaces) {
+      if (i.alt_setting != 0) continue;
+      InterfaceDriver drv;
+      drv.interface_number = i.number;
+      drv.sysfs_driver = sysfs_interface_driver(d.port_path, c->value, i.number);
+      drv.libusb_active = kernel_driver_active(&handle, i.number);
+      p.drivers.push_back(drv);
+    }
+  }
+  return p;
+}
+
+CaptureResult capture_touch(const CaptureOptions& o) {
+  if (!std::isfinite(o.duration_s) || !(o.duration_s > 0.0)) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%g", o.duration_s);
+    throw UsbUsageError(std::string("--duration ") + buf +
+                        ": must be a finite number of seconds > 0");
+  }
+  if (o.out_path.empty()) throw UsbUsageError("--out: a capture file is required");
+
+  UsbContext ctx;
+  UsbDeviceList list(ctx);
+  const UsbDeviceInfo& d = select_touch(list, o.where);
+  const std::string who = describe(d);
+  const UsbDescriptors desc = read_descriptors(d);
+  const UsbConfiguration* config = find_configuration(desc, active_configuration(d, desc));
+  if (config == nullptr) {
+    throw UsbDeviceError(who + ": no active configuration in its descriptors");
+  }
+  const UsbInterface* intf = find_data_interface(*config);
+  if (intf == nullptr) {
+    throw UsbDeviceError(who + ": no interface with a bulk or interrupt IN endpoint");
+  }
+  const std::vector<UsbEndpoint> eps = capture_endpoints(*intf);
+
+  int error = 0;
+  UsbHandle handle(d.device, &error);
+  CaptureResult r;
+  r.device = listing(d, error);
+  if (!handle.is_open()) throw UsbDeviceError(who + ": " + r.device.why_not);
+  r.interface_number = intf->number;
+  for (const UsbEndpoint& e : eps) r.endpoints.push_back(e.address);
+
+  // a kernel driver (cdc_acm) holds the data interface: release it only
+  // when asked to, since that takes the device away from its serial port
+  r.kernel_driver = sysfs_interface_driver(d.port_path, config->value, intf->number);
+  const std::optional<bool> active = kernel_driver_active(&handle, intf->number);
+  if (r.kernel_driver.empty() && active.value_or(false)) r.kernel_driver = "a kernel driver";
+  if (!r.kernel_driver.empty() && !o.detach) {
+    throw UsbDeviceError("interface " + std::to_string(intf->number) + " of " + who +
+                         " is held by " + r.kernel_driver +
+                         "; pass --detach to release it for the capture (it is "
+                         "re-attached afterwards)");
+  }
+  ClaimedInterface claim(&handle, intf->number, o.detach, who);
+  r.detached = claim.detached();
+
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(o.out_path.c_str(), "w"));
+  if (!file) {
+    throw UsbUsageError("--out " + o.out_path + ": cannot write: " + std::strerror(errno));
+  }
+  r.out_path = o.out_path;
+  CaptureHeader h;
+  h.device_id = r.device.id;
+  h.where = {d.bus, d.address};
+  h.port_path = d.port_path;
+  h.interface_number = intf->number;
+  h.endpoints = r.endpoints;
+  h.duration_s = o.duration_s;
+  h.started_utc = utc_now();
+  std::fputs(format_capture_header(h).c_str(), file.get());
+  std::fflush(file.get());
+
+  const Clock::time_point t0 = Clock::now();
+  const auto elapsed_s = [&]() {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+  std::size_t next = 0;
+  while (r.error.empty()) {
+    const double left_s = o.duration_s - elapsed_s();
+    if (left_s <= 0.0) break;
+    const UsbEndpoint& ep = eps[next];
+    next = (next + 1) % eps.size();
+    const unsigned timeout_ms = static_cast<unsigned>(
+        std::max(1.0, std::min<double>(o.transfer_timeout_ms, std::ceil(1e3 * left_s))));
+    const TransferResult t = read_in_endpoint(ctx, &handle, ep.address,
+                                              ep.transfer_type == "interrupt",
+                                              ep.max_packet_size, timeout_ms);
+    const double t_s = elapsed_s();
+    if (t.outcome == TransferOutcome::kCompleted ||
+        (t.outcome == TransferOutcome::kTimedOut && !t.data.empty())) {
+      const std::string line =
+          format_capture_record(t_s, ep.address, t.data.data(), t.data.size());
+      if (std::fputs(line.c_str(), file.get()) < 0 || std::fflush(file.get()) != 0) {
+        r.error = "writing " + o.out_path + ": " + std::strerror(errno);
+        break;
+      }
+      ++r.transfers;
+      r.bytes += t.data.size();
+    }
+    char epname[8];
+    std::snprintf(epname, sizeof epname, "0x%02x", static_cast<unsigned>(ep.address));
+    switch (t.outcome) {
+      case TransferOutcome::kCompleted: break;
+      case TransferOutcome::kTimedOut:
+        if (t.data.empty()) ++r.timeouts;
+        break;
+      case TransferOutcome::kNoDevice:
+        r.device_lost = true;
+        r.error = "the Touch " + who + " was unplugged during the capture "
+                  "(LIBUSB_ERROR_NO_DEVICE on endpoint " + epname + ")";
+        break;
+      case TransferOutcome::kStall:
+        r.error = "endpoint " + std::string(epname) + " of " + who + " stalled";
+        break;
+      case TransferOutcome::kOverflow:
+        r.error = "endpoint " + std::string(epname) + " of " + who +
+                  " sent more than wMaxPacketSize (" + std::to_string(ep.max_packet_size) +
+                  " bytes)";
+        break;
+      case TransferOutcome::kError:
+        r.error = "reading endpoint " + std::string(epname) + " of " + who + ": " + t.detail;
+        break;
+    }
+  }
+  r.elapsed_s = elapsed_s();
+  const std::string last = r.error.empty()
+                               ? format_capture_end(r.transfers, r.bytes, r.timeouts, r.elapsed_s)
+                               : format_capture_error(r.error, r.transfers);
+  std::fputs(last.c_str(), file.get());
+  std::fflush(file.get());
+  return r;
+}
+
+}  // namespace vmh::hw::usb
