@@ -478,7 +478,7 @@ void Raw1394Transport::start() {
 void Raw1394Transport::stop() noexcept {
   if (!started_ || h_ == nullptr) return;
   // let the last command (the caller's zero packet) go out for a few cycles
-  for (int i = 0; i < 5; ++i) pump(1000000);
+  for (int i = 0; i < 5; ++i) pump(1e-3);
   const auto id = static_cast<nodeid_t>(kLocalBus | node_.node);
   write_byte(h_->ctrl, id, kRegStart, kStopValue);
   shutdown_iso();
@@ -499,13 +499,19 @@ void Raw1394Transport::shutdown_iso() noexcept {
   }
 }
 
-// Waits up to timeout_ns for any of the three handles and lets libraw1394
+// Waits up to timeout_s for any of the three handles and lets libraw1394
 // run the handlers of what arrived. kOk also when nothing did.
-TransportStatus Raw1394Transport::pump(int timeout_ns) noexcept {
+TransportStatus Raw1394Transport::pump(double timeout_s) noexcept {
   pollfd fds[3] = {{raw1394_get_fd(h_->ctrl), POLLIN, 0},
                    {raw1394_get_fd(h_->rx), POLLIN, 0},
                    {raw1394_get_fd(h_->tx), POLLIN, 0}};
-  timespec ts{0, timeout_ns < 0 ? 0 : timeout_ns};
+  timespec ts{0, 0};
+  if (timeout_s > 0.0) {
+    const auto whole = static_cast<std::time_t>(timeout_s);
+    ts.tv_sec = whole;
+    ts.tv_nsec = static_cast<long>((timeout_s - static_cast<double>(whole)) * 1e9);
+    if (ts.tv_nsec >= 1000000000L) ts.tv_nsec = 999999999L;
+  }
   const int n = ppoll(fds, 3, &ts, nullptr);
   if (n < 0) return errno == EINTR ? TransportStatus::kOk : TransportStatus::kIo;
   raw1394handle_t hs[3] = {h_->ctrl, h_->rx, h_->tx};
@@ -550,7 +556,7 @@ TransportStatus Raw1394Transport::receive(std::uint8_t* buf,
       timeouts_.fetch_add(1, std::memory_order_relaxed);
       return TransportStatus::kTimeout;
     }
-    const TransportStatus s = pump(static_cast<int>(left * 1e9));
+    const TransportStatus s = pump(left);
     if (s != TransportStatus::kOk) return s;
   }
 }
@@ -563,7 +569,7 @@ TransportStatus Raw1394Transport::send(const std::uint8_t* data,
   }
   std::memcpy(tx_packet_.data(), data, kCommandPacketBytes);
   sent_.fetch_add(1, std::memory_order_relaxed);
-  return pump(0);  // keeps the transmit context fed between receives
+  return pump(0.0);  // keeps the transmit context fed between receives
 }
 
 bool Raw1394Transport::find_node_again() noexcept {

@@ -74,6 +74,7 @@ class Raw1394Transport final : public Transport {
   Raw1394Transport(const Raw1394Transport&) = delete;
   Raw1394Transport& operator=(const Raw1394Transport&) = delete;
 
+  // the node found (call it outside the servo loop: recover() updates it)
   NodeInfo node() const override { return node_; }
   void start() override;
   void stop() noexcept override;
@@ -97,7 +98,7 @@ class Raw1394Transport final : public Transport {
   void shutdown_iso() noexcept;
   void close_handles() noexcept;
   bool find_node_again() noexcept;
-  TransportStatus pump(int timeout_ns) noexcept;
+  TransportStatus pump(double timeout_s) noexcept;
 
   friend struct Raw1394Callbacks;
 
