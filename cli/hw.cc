@@ -17,6 +17,7 @@
 
 #include "cli/args.h"
 #include "cli/hw_common.h"
+#include "cli/hw_usb.h"
 #include "controller/device_frame.h"
 
 namespace vmh::cli {
@@ -45,6 +46,9 @@ const HwSample* last_reading(const SessionResult& r) {
 
 void probe(const RecordOptions& o) {
   if (!(o.seconds > 0.0)) throw UsageError("hw probe: --seconds must be > 0");
+  // the USB Touch: its descriptors only, no servo backend (cli/hw_usb.cc)
+  const DeviceSpec spec = parse_device_spec(o.common.device);
+  if (spec.backend == "usb") return usb_probe(spec.argument);
   OpenedDevice dev = open_hw_device(o.common, "tour");
   SessionOptions so = session_options(o.common, "probe");
   so.mode = HwMode::kRecord;
@@ -198,6 +202,7 @@ void register_hw(CLI::App* app) {
 
   register_hw_run(hw);
   register_hw_calibrate(hw);
+  register_hw_capture(hw);
 }
 
 }  // namespace vmh::cli

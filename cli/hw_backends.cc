@@ -8,6 +8,7 @@
 
 #include "cli/args.h"
 #include "cli/hw_calibration_store.h"
+#include "cli/hw_usb.h"
 #include "device/servo_thread.h"
 #include "hw/openhaptics/hd_library.h"
 #include "hw/openhaptics/openhaptics_backend.h"
@@ -147,27 +148,6 @@ Json dev_nodes(const std::string& prefix) {
   return out;
 }
 
-std::string read_line(const fs::path& p) {
-  std::ifstream in(p);
-  std::string s;
-  std::getline(in, s);
-  return s;
-}
-
-// USB devices with a Touch's IDs (docs/sources.md §9.3), from sysfs
-Json usb_touch_devices() {
-  Json out = Json::array();
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator("/sys/bus/usb/devices", ec)) {
-    const std::string v = read_line(e.path() / "idVendor");
-    const std::string p = read_line(e.path() / "idProduct");
-    const bool touch = (v == "0301" && p == "2988") ||
-                       (v == "2988" && (p == "0302" || p == "0304"));
-    if (touch) out.push_back(e.path().filename().string() + " " + v + ":" + p);
-  }
-  return out;
-}
-
 }  // namespace
 
 DeviceSpec parse_device_spec(const std::string& text) {
@@ -218,13 +198,8 @@ Json list_backends() {
                       {"why_not", "the native FireWire Omni driver is not built "
                                   "yet; use openhaptics for a FireWire Omni"},
                       {"verified_on_hardware", false}});
-  list.push_back(Json{{"name", "usb_touch"},
-                      {"device", "(native driver, not in this version)"},
-                      {"available", false},
-                      {"found", usb_touch_devices()},
-                      {"why_not", "the native USB Touch driver is not built "
-                                  "yet; use openhaptics for a Touch"},
-                      {"verified_on_hardware", false}});
+  // the USB Touch through libusb (cli/hw_usb.cc): probe and capture only
+  list.push_back(usb_touch_backend_json());
   return Json{{"backends", list}};
 }
 
