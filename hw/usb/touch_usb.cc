@@ -63,9 +63,17 @@ const UsbDeviceInfo& select_touch(const UsbDeviceList& list,
                         std::to_string(where->bus) + " address " +
                         std::to_string(where->address) + " (`vmhaptics hw list`)");
   }
+  // the first by bus, then address, so that "usb" names the same device
+  // whatever order libusb enumerates in
+  const UsbDeviceInfo* first = nullptr;
   for (const UsbDeviceInfo& d : list.devices()) {
-    if (is_touch_id(d.vendor_id, d.product_id)) return d;
+    if (!is_touch_id(d.vendor_id, d.product_id)) continue;
+    if (first == nullptr || d.bus < first->bus ||
+        (d.bus == first->bus && d.address < first->address)) {
+      first = &d;
+    }
   }
+  if (first != nullptr) return *first;
   throw UsbUsageError("--device usb: no USB Touch found (looked for 2988:0301, "
                       "2988:0302, 2988:0304 and 0301:2988)");
 }
@@ -161,6 +169,10 @@ TouchScan list_touch_devices() {
     scan.found.clear();
     scan.why_none = e.what();
   }
+  std::sort(scan.found.begin(), scan.found.end(),
+            [](const TouchListing& a, const TouchListing& b) {
+              return a.bus != b.bus ? a.bus < b.bus : a.address < b.address;
+            });
   return scan;
 }
 

@@ -31,8 +31,8 @@ struct TouchScan {
   std::string why_none;
 };
 
-// Every USB device whose IDs are in touch_ids(); each is opened once to say
-// whether this user may use it. Never throws.
+// Every USB device whose IDs are in touch_ids(), by bus then address; each
+// is opened once to say whether this user may use it. Never throws.
 TouchScan list_touch_devices();
 
 // A string descriptor as far as it could be read.
@@ -59,8 +59,9 @@ struct TouchProbe {
   std::vector<InterfaceDriver> drivers;  // of the active configuration
 };
 
-// The Touch at `where`, or the first one found. Throws UsbUsageError when
-// there is no device at `where`, it is not a Touch, or no Touch is present;
+// The Touch at `where`, or the first one (lowest bus, then address).
+// Throws UsbUsageError when there is no device at `where`, it is not a
+// Touch, or no Touch is present;
 // UsbDeviceError when its descriptors cannot be read. A Touch that cannot
 // be opened is still described (from sysfs); `device.why_not` says why.
 TouchProbe probe_touch(const std::optional<BusAddress>& where);
