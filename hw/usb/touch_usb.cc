@@ -24,13 +24,7 @@ std::string describe(const UsbDeviceInfo& d) {
 }
 
 std::string open_failure(int error, const UsbDeviceInfo& d) {
-  const std::string node = usbfs_path({d.bus, d.address});
-  if (error == LIBUSB_ERROR_ACCESS) {
-    return "permission denied opening " + node +
-           ": install hw/udev/60-vmhaptics.rules (hw/udev/README.md, "
-           "docs/hardware.md)";
-  }
-  return "could not open " + node + ": " + usb_error_text(error);
+  return open_failure_text(error, {d.bus, d.address});
 }
 
 TouchListing listing(const UsbDeviceInfo& d, int open_error) {
@@ -153,6 +147,16 @@ struct FileCloser {
 };
 
 }  // namespace
+
+std::string open_failure_text(int libusb_error, const BusAddress& where) {
+  const std::string node = usbfs_path(where);
+  if (libusb_error == LIBUSB_ERROR_ACCESS) {
+    return "permission denied opening " + node +
+           ": install hw/udev/60-vmhaptics.rules (hw/udev/README.md, "
+           "docs/hardware.md)";
+  }
+  return "could not open " + node + ": " + usb_error_text(libusb_error);
+}
 
 TouchScan list_touch_devices() {
   TouchScan scan;

@@ -25,6 +25,10 @@ struct TouchListing {
   std::string why_not;      // when not accessible
 };
 
+// Why a Touch at `where` could not be opened, from libusb_open's error:
+// for LIBUSB_ERROR_ACCESS, the udev rule to install; else libusb's name.
+std::string open_failure_text(int libusb_error, const BusAddress& where);
+
 struct TouchScan {
   std::vector<TouchListing> found;
   // set when libusb itself could not start or list (then `found` is empty)

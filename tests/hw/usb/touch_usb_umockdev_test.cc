@@ -43,6 +43,17 @@ class Testbed {
     const bool ok = umockdev_testbed_add_from_file(tb_, (kDir + "/" + file).c_str(), &e);
     ASSERT_TRUE(ok) << file << ": " << (e ? e->message : "");
   }
+  // a description from this folder with the lines starting `drop` removed
+  void add_without(const std::string& file, const std::string& drop) {
+    std::ifstream in(kDir + "/" + file);
+    std::string line, text;
+    while (std::getline(in, line)) {
+      if (line.rfind(drop, 0) != 0) text += line + "\n";
+    }
+    GError* e = nullptr;
+    const bool ok = umockdev_testbed_add_from_string(tb_, text.c_str(), &e);
+    ASSERT_TRUE(ok) << file << ": " << (e ? e->message : "");
+  }
   void replay(const std::string& devnode, const std::string& file) {
     GError* e = nullptr;
     const bool ok =
@@ -132,6 +143,35 @@ TEST_F(TouchUsb, ListIsEmptyWithOnlyAnotherDevice) {
   const TouchScan scan = list_touch_devices();
   EXPECT_TRUE(scan.found.empty());
   EXPECT_TRUE(scan.why_none.empty()) << scan.why_none;
+}
+
+// a Touch libusb lists but cannot open (its /dev node is missing): listed,
+// not accessible, and why; the probe still describes it from sysfs
+TEST_F(TouchUsb, ListSaysWhyATouchCannotBeOpened) {
+  Testbed tb;
+  tb.add_without("touch_0301_early.umockdev", "N:");
+  const TouchScan scan = list_touch_devices();
+  ASSERT_EQ(scan.found.size(), 1u);
+  EXPECT_FALSE(scan.found[0].accessible);
+  EXPECT_EQ(scan.found[0].why_not.rfind("could not open /dev/bus/usb/002/003: LIBUSB_ERROR_", 0), 0u)
+      << scan.found[0].why_not;
+  const TouchProbe p = probe_touch(std::nullopt);
+  EXPECT_FALSE(p.device.accessible);
+  EXPECT_EQ(p.descriptors.device.product_id, 0x2988);
+  EXPECT_NE(p.serial.why_not.find("could not be opened"), std::string::npos) << p.serial.why_not;
+  CaptureOptions o;
+  o.duration_s = 0.1;
+  o.out_path = out_file("noopen.txt").string();
+  EXPECT_THROW(capture_touch(o), UsbDeviceError);
+  EXPECT_FALSE(fs::exists(o.out_path));
+}
+
+// the text a user without the udev rule sees (the tests run as root, so
+// libusb_open cannot be made to fail with EACCES here)
+TEST(TouchUsbText, PermissionDeniedPointsAtTheUdevRule) {
+  EXPECT_EQ(open_failure_text(LIBUSB_ERROR_ACCESS, BusAddress{1, 5}),
+            "permission denied opening /dev/bus/usb/001/005: install "
+            "hw/udev/60-vmhaptics.rules (hw/udev/README.md, docs/hardware.md)");
 }
 
 TEST_F(TouchUsb, ProbeGivesTheDescribedDescriptorsStringsAndDrivers) {
