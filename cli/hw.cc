@@ -202,6 +202,7 @@ void register_hw(CLI::App* app) {
 
   register_hw_run(hw);
   register_hw_calibrate(hw);
+  register_hw_packet(hw);
   register_hw_capture(hw);
 }
 

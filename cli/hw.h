@@ -13,6 +13,8 @@ void register_hw(CLI::App* app);
 // the sub-verbs, each in its own file
 void register_hw_run(CLI::App* hw);
 void register_hw_calibrate(CLI::App* hw);
+// hw decode / hw encode: the FireWire Omni's packets by hand (hw_packet.cc)
+void register_hw_packet(CLI::App* hw);
 
 }  // namespace vmh::cli
 

@@ -1,7 +1,8 @@
 // vmhaptics hw calibrate [--device D] [--dock-s s] [--sweep-s s]
 //
 // Joint-angle calibration of a device that reports raw sensor values (the
-// emulator now; the native FireWire driver later), stored per serial number
+// emulator, directly or behind the FireWire packets, and the native
+// FireWire driver), stored per serial number
 // (cli/hw_calibration_store.h) and loaded by the other hw verbs:
 //   1. the stylus in the inkwell: the encoder offsets that make the docked
 //      counts read as the inkwell pose (hw::fit_encoder_offsets);
@@ -24,6 +25,7 @@
 #include "cli/hw_common.h"
 #include "controller/device_frame.h"
 #include "controller/omni_params.h"
+#include "hw/firewire/firewire_omni.h"
 #include "hw/openhaptics/openhaptics_backend.h"
 #include "sim/emulator.h"
 
@@ -118,8 +120,12 @@ void calibrate(const CalibrateOptions& o) {
   }
   const Vec3 inkwell(sim::kInkwellDevice_rad[0], sim::kInkwellDevice_rad[1],
                      sim::kInkwellDevice_rad[2]);
-  hw::OmniCalibration cal =
-      emu != nullptr ? emu->calibration() : hw::OmniCalibration{};
+  // start from the calibration the device decodes with (its pot gains'
+  // signs are kept below)
+  hw::OmniCalibration cal = dev.firewire != nullptr
+                                ? dev.firewire->omni()->calibration()
+                                : emu != nullptr ? emu->calibration()
+                                                 : hw::OmniCalibration{};
   cal.encoder_offset_rad = hw::fit_encoder_offsets(mean, inkwell);
 
   // 2. gimbal: the extreme codes of the sweep phase are the range's ends

@@ -9,14 +9,18 @@ namespace vmh::cli {
 
 void add_hw_common(CLI::App* cmd, HwCommon* c) {
   cmd->add_option("--device", c->device,
-                  "emulator[:case|scene.xml] (default) or "
-                  "openhaptics[:CONFIG_NAME]");
+                  "emulator[:case|scene.xml] (default), "
+                  "emulator:firewire[:case|scene.xml] (the emulator behind the "
+                  "FireWire packets), openhaptics[:CONFIG_NAME] or "
+                  "firewire[:GUID]");
   cmd->add_option("--hand", c->hand,
                   "emulator: what holds the stylus: case, tour, none, dock, "
                   "gimbal_sweep (default depends on the verb)");
   cmd->add_option("--fault", c->faults,
                   "emulator: transport faults, e.g. "
-                  "drop@1.0:5,late@2:0.5:3,stall@3:0.2,unplug@4:1");
+                  "drop@1.0:5,late@2:0.5:3,stall@3:0.2,unplug@4:1; "
+                  "emulator:firewire: packet faults, e.g. loss@1:5,"
+                  "late@2:0.5:3,length@3:2,reset@4,unplug@5:1,stall@6:0.2");
   cmd->add_option("--emulator-fault", c->seeded,
                   "emulator: seeded faults for bring-up tests, comma-separated: "
                   "joint<N>_sign, gimbal_swap, link_length_<P>pct, delay_<M>ms, "

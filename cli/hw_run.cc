@@ -112,7 +112,9 @@ void hw_run(const HwRunOptions& o) {
                        "it as the target, not in --device (" + common.device +
                        ")");
     }
-    common.device = "emulator:" + scene;
+    DeviceSpec with_scene = spec;  // emulator or emulator:firewire
+    with_scene.argument = scene;
+    common.device = with_scene.text();
   }
   const double duration_s = model->config().sim.duration_s;
   if (spec.backend != "emulator") {

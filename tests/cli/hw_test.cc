@@ -74,7 +74,8 @@ TEST(HwCli, ListNamesEveryBackendAndWhyNot) {
     }
   }
   EXPECT_EQ(names, (std::vector<std::string>{"emulator", "openhaptics",
-                                             "firewire", "usb_touch"}));
+                                             "firewire", "usb_touch",
+                                             "emulator:firewire"}));
   EXPECT_TRUE(j["backends"][0]["available"].get<bool>());
 }
 
