@@ -23,7 +23,7 @@ const std::string kDir = VMH_USB_TEST_DIR;
 
 // `umockdev-run` with these descriptions (and ioctl replays), then the CLI
 std::string under(const std::vector<std::string>& devices, const std::string& ioctl = "") {
-  std::string s = "umockdev-run";
+  std::string s = VMH_UMOCKDEV_RUN;
   for (const std::string& d : devices) s += " --device " + kDir + "/" + d;
   if (!ioctl.empty()) s += " --ioctl /dev/bus/usb/001/005=" + kDir + "/" + ioctl;
   return s + " -- ";
