@@ -230,6 +230,10 @@ CaptureResult capture_touch(const CaptureOptions& o) {
     throw UsbDeviceError(who + ": no interface with a bulk or interrupt IN endpoint");
   }
   const std::vector<UsbEndpoint> eps = capture_endpoints(*intf);
+  if (eps.empty()) {
+    throw UsbDeviceError(who + ": interface " + std::to_string(intf->number) +
+                         " has no bulk or interrupt IN endpoint to read");
+  }
 
   int error = 0;
   UsbHandle handle(d.device, &error);
