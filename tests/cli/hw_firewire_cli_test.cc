@@ -245,6 +245,15 @@ TEST(HwFirewireCli, PacketFaultsShowInTheSessionAndItCarriesOn) {
   EXPECT_EQ(e.value("io", 0L), 3) << e.dump();
   EXPECT_GE(e.value("not_connected", 0L), 1) << e.dump();
   EXPECT_EQ(m.at("device").at("backend"), "emulator:firewire");
+  // the packets' own account: three of the wrong length, one bus reset
+  // recovered from; the counter's gaps are the five lost packets and the
+  // three refused ones, whose counters the device never decoded
+  const json fw = m.at("firewire");
+  EXPECT_EQ(fw.at("device").at("lost_packets"), 5 + 3) << fw.dump();
+  EXPECT_EQ(fw.at("device").at("bad_packets"), 3) << fw.dump();
+  EXPECT_EQ(fw.at("transport").at("bus_resets"), 1) << fw.dump();
+  EXPECT_EQ(fw.at("transport").at("recoveries"), 1) << fw.dump();
+  EXPECT_EQ(fw.at("node").at("vendor"), 0x000b99) << fw.dump();
 }
 
 TEST(HwFirewireCli, UnpluggedForGoodIsDeviceGone) {
