@@ -165,7 +165,8 @@ void register_hw(CLI::App* app) {
   CLI::App* hw = app->add_subcommand(
       "hw",
       "a haptic device, real or emulated, through the same servo_tick and "
-      "safety layer: list, probe, record, run, calibrate, motor-test "
+      "safety layer: list, probe, record, run, calibrate, motor-test; "
+      "capture (USB Touch traffic), decode and encode (FireWire packets) "
       "(docs/hardware.md)");
   hw->require_subcommand(1);
 

@@ -45,7 +45,8 @@ SessionOptions session_options(const HwCommon& c, const std::string& verb);
 // report and timing, the stop reason: what meta.json holds; on the
 // emulator also "emulator": its scene (absolute path), hand program, model
 // file (or null) and, as the emulator's hidden setup for tests,
-// "seeded_faults"
+// "seeded_faults"; on firewire and emulator:firewire also "firewire": the
+// node, the transport's and the device's packet counts
 Json identity_json(const DeviceIdentity& id);
 Json timing_json(const TickStats& t);
 Json session_json(const SessionResult& r);
