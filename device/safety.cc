@@ -250,8 +250,13 @@ DeviceError SafetyLayer::read_state(DeviceState* state) noexcept {
   tip_speed_ = 0.0;
   joint_speed_ = 0.0;
   if (have_previous_) {
-    tip_speed_ = (p_m - p_prev_m_).norm() / dt_s_;
-    joint_speed_ = (q.head<3>() - q_prev_.head<3>()).cwiseAbs().maxCoeff() / dt_s_;
+    // speeds over at least half a servo period: two readings stamped closer
+    // than that (a device or emulator catching up after a stall) would turn
+    // one encoder count (0.42 mrad) into a speed over 0.8 rad/s and more
+    const double dt_speed_s = std::max(dt_s_, 0.5 * params_.servo_period_s);
+    tip_speed_ = (p_m - p_prev_m_).norm() / dt_speed_s;
+    joint_speed_ =
+        (q.head<3>() - q_prev_.head<3>()).cwiseAbs().maxCoeff() / dt_speed_s;
     if (tip_speed_ > params_.max_tip_speed_m_s ||
         joint_speed_ > params_.max_joint_speed_rad_s) {
       velocity_exceeded_ = true;

@@ -295,6 +295,33 @@ TEST(SafetyLayer, JointVelocityCutsAndUsesTheStampedPeriod) {
   EXPECT_EQ(rig.layer.status(), kSafetyOk);
 }
 
+// Readings stamped much closer than a servo period (a source catching up
+// after a stall) are measured over half a period at least, so one encoder
+// count does not read as a fling; a real fling still does.
+TEST(SafetyLayer, ReadingsCloserThanHalfAPeriodAreNotAFling) {
+  SafetyParams p = quiet();
+  p.max_joint_speed_rad_s = 2.0;
+  p.resume_joint_speed_rad_s = 1.0;
+  Rig rig(p);
+  const double count_rad = 2.0 * 3.14159265358979323846 / 15000.0;
+  double t = 0.0;
+  rig.layer.set_read_time(t);
+  rig.tick(kSmall);
+  // one count 0.1 ms later: 4.2 rad/s over 0.1 ms, 0.84 rad/s over 0.5 ms
+  t += 1e-4;
+  rig.dev.q[0] += count_rad;
+  rig.layer.set_read_time(t);
+  EXPECT_EQ(rig.tick(kSmall), kSmall);
+  EXPECT_NEAR(rig.layer.joint_speed_rad_s(), count_rad / (0.5 * kDt), 1e-9);
+  EXPECT_EQ(rig.layer.status(), kSafetyOk);
+  // 0.01 rad in 0.1 ms still cuts (20 rad/s over the half period)
+  t += 1e-4;
+  rig.dev.q[0] += 0.01;
+  rig.layer.set_read_time(t);
+  EXPECT_EQ(rig.tick(kSmall), Vec3::Zero());
+  EXPECT_TRUE(rig.layer.status() & kSafetyVelocityExceeded);
+}
+
 TEST(SafetyInputs, DockedAndDeadman) {
   SafetyParams p = quiet();
   p.require_deadman = true;
