@@ -133,6 +133,8 @@ void hw_run(const HwRunOptions& o) {
   so.keep_samples = dev.emulator != nullptr;
   so.servo.period_s = params.servo_period_s;
   so.safety.servo_period_s = params.servo_period_s;
+  // the case's torque limits (torque_limits) bound the safety layer too
+  so.safety.motor_torque_limit_Nm = params.omni.motor_torque_limit_Nm;
   so.guard.max_period_s = 4.0 * params.servo_period_s;
   const SessionResult r = run_session(&dev, so);
 

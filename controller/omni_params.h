@@ -48,7 +48,10 @@ struct OmniParams {
                                                      2.45, 1.13, 2.58};
 
   // -- ratings --
-  // motor torque clamps of the three actuated joints [oh]: 200, 350, 200 mN·m
+  // motor torque clamps of the three actuated joints [oh]: 200, 350, 200
+  // mN·m, the OpenHaptics samples' (TorqueLimits::kOpenHapticsSamples). The
+  // limits derived from the rated force, 0.44 N·m each, are
+  // TorqueLimits::kRated (controller/omni_ratings.h, docs/safety.md).
   std::array<double, kOmniActuated> motor_torque_limit_Nm = {0.200, 0.350,
                                                              0.200};
   double max_force_N = 3.3;          // peak force at nominal position [oh]

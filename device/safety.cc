@@ -7,6 +7,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "controller/omni_ratings.h"
 #include "device/motor_force_map.h"
 
 namespace vmh {
@@ -42,19 +43,6 @@ void require(bool ok, const char* field, const char* what) {
 }
 
 bool positive(double v) { return std::isfinite(v) && v > 0.0; }
-
-// J_v, the linear rows of the wrist-centre Jacobian, DH base frame, m/rad
-Mat3 linear_jacobian(const OmniParams& omni, const Joints& q_dh) {
-  return omni_jacobian(omni, q_dh).topLeftCorner<3, 3>();
-}
-
-// the matrix of a linear map Vec3 -> Vec3 given as a function
-template <typename F>
-Mat3 matrix_of(F f) {
-  Mat3 m;
-  for (int i = 0; i < 3; ++i) m.col(i) = f(Vec3::Unit(i));
-  return m;
-}
 
 }  // namespace
 
@@ -129,12 +117,12 @@ SafetyLayer::SafetyLayer(HapticDevice* inner, const SafetyParams& params,
   omni_.validate();
   watchdog_ = ServoWatchdog(params_.servo_period_s, params_.watchdog_periods);
   // continuous torque of each motor: the largest torque a continuous force
-  // in any direction needs at the nominal pose (DH q = 0, arms orthogonal).
-  // tau_motor = D J_v^T F_base, so motor i's worst case is |row i| |F|.
-  const Mat3 D = matrix_of([](const Vec3& v) { return dh_to_motor_torques(v); });
-  const Mat3 DJt = D * linear_jacobian(omni_, Joints::Zero()).transpose();
+  // in any direction needs at the nominal pose (DH q = 0, arms orthogonal),
+  // as the rated torque limits are derived (controller/omni_ratings.h)
+  const std::array<double, kOmniActuated> cont =
+      motor_torques_for_force_Nm(omni_, params_.continuous_force_N);
   for (int i = 0; i < 3; ++i) {
-    tau_cont_[i] = params_.continuous_force_N * DJt.row(i).norm();
+    tau_cont_[i] = cont[static_cast<std::size_t>(i)];
     if (!positive(tau_cont_[i])) {
       throw std::invalid_argument(
           "SafetyLayer: a motor takes no torque at the nominal pose");

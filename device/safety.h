@@ -82,9 +82,11 @@ struct SafetyParams {
   // -- clamps --
   // force at the wrist centre, N: the Omni's peak force [§7]
   double max_force_N = 3.3;
-  // motors t1..t3, N m: the OpenHaptics samples' clamps [§7]
-  std::array<double, kOmniActuated> motor_torque_limit_Nm = {0.200, 0.350,
-                                                             0.200};
+  // motors t1..t3, N m: OmniParams' (the OpenHaptics samples' clamps [§7]);
+  // the limits derived from the rated force are
+  // motor_torque_limits_Nm(omni, TorqueLimits::kRated)
+  std::array<double, kOmniActuated> motor_torque_limit_Nm =
+      OmniParams{}.motor_torque_limit_Nm;
   // regularisation of J_v J_v^T when turning torques into a force, m
   // (damped least squares). It changes the force by about
   // (damping / sigma_min)^2 relative, sigma_min the smallest singular value

@@ -214,6 +214,15 @@ const std::vector<ParamSpec>& case_fields() {
               })
           .positive()
           .ctl("--force-limit-N"),
+      text("controller", "torque_limits", "openhaptics_samples",
+           "openhaptics_samples, rated",
+           "motor torque limits t1..t3: openhaptics_samples (0.2, 0.35, 0.2 "
+           "N m) or rated (the rated 3.3 N in any direction at the nominal "
+           "pose, 0.44 N m each; the scene's motor ranges follow)",
+           [](CaseParams* p, const ParamValue& v) {
+             p->controller.torque_limits = parse_torque_limits(v.text);
+           })
+          .ctl("--torque-limits"),
 
       // ---- the simulator ----
       numeric("sim", "physics_step_s", 1, "0", "s",

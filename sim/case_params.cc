@@ -316,6 +316,7 @@ ControllerParams controller_params(const ControllerSettings& s) {
   p.placement = s.placement;
   p.servo_period_s = s.servo_period_s;
   p.force_limit_N = s.force_limit_N;
+  p.omni.motor_torque_limit_Nm = motor_torque_limits_Nm(p.omni, s.torque_limits);
   return p;
 }
 

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "controller/controller.h"
+#include "controller/omni_ratings.h"
 #include "controller/types.h"
 #include "sim/fault_injector.h"
 
@@ -60,6 +61,7 @@ struct ControllerSettings {
   PlacementMethod placement{};
   double servo_period_s{};
   double force_limit_N{};
+  TorqueLimits torque_limits = TorqueLimits::kOpenHapticsSamples;  // controller/omni_ratings.h
 };
 
 // The simulator's settings around the controller.

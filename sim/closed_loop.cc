@@ -134,6 +134,21 @@ void ClosedLoop::build_controller() {
       params_.omni.joint_upper_rad[static_cast<std::size_t>(i)] = kPi;
     }
   }
+  // the motors' range follows the case's torque limits (torque_limits):
+  // omni.xml's ctrlrange is the OpenHaptics samples' clamps, which would
+  // otherwise cut the rated limits' torques in the simulated motors
+  for (int i = 0; i < kOmniActuated; ++i) {
+    const std::string name = "m" + std::to_string(i + 1);
+    const int a = mj_name2id(m, mjOBJ_ACTUATOR, name.c_str());
+    if (a < 0 || !m->actuator_ctrllimited[a]) continue;
+    const double lim = params_.omni.motor_torque_limit_Nm[static_cast<std::size_t>(i)];
+    m->actuator_ctrlrange[2 * a] = -lim;
+    m->actuator_ctrlrange[2 * a + 1] = lim;
+    if (m->actuator_forcelimited[a]) {
+      m->actuator_forcerange[2 * a] = -lim;
+      m->actuator_forcerange[2 * a + 1] = lim;
+    }
+  }
   try {
     params_.validate();
     controller_ = std::make_unique<Controller>(params_);

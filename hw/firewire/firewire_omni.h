@@ -50,11 +50,12 @@ class ServoThread;
 namespace vmh::hw::fw {
 
 // Torque on a motor's joint at full-scale command u = +-1, N m: an
-// ESTIMATE (no public source gives the DAC's scale). It is the largest of
-// OpenHaptics's sample torque clamps (docs/sources.md §7), so that no clamp
-// the safety layer applies is cut by the codec. To be measured on a device
+// ESTIMATE (no public source gives the DAC's scale). It is the rated torque
+// limit (the 3.3 N peak force at the nominal pose, 3.3 x 0.13335 m,
+// controller/omni_ratings.h), the largest limit the safety layer applies,
+// so that no limit is cut by the codec. To be measured on a device
 // (hw motor-test, then identify).
-inline constexpr double kMotorFullScaleEstimate_Nm = 0.35;
+inline constexpr double kMotorFullScaleEstimate_Nm = 3.3 * 0.13335;
 
 // A calibration to start from before `hw calibrate` has fitted the unit's
 // own: encoder offsets zero (angles relative to where the counters started)

@@ -140,10 +140,11 @@ TEST(SafetyLayer, ForceAtThePoseMatchesAFiniteDifferenceJacobian) {
 
 TEST(SafetyLayer, TorqueClampScalesAllMotorsByOneFactor) {
   Rig rig;
-  const Vec3 tau(0.5, 0.1, -0.05);  // motor 1 at 2.5x its 0.2 N m clamp
+  const double lim = SafetyParams().motor_torque_limit_Nm[0];
+  const Vec3 tau(2.5 * lim, 0.1, -0.05);  // motor 1 at 2.5x its limit
   const Vec3 out = rig.tick(tau);
-  EXPECT_NEAR(out[0], 0.2, 1e-12);
-  EXPECT_LT((out - tau * (0.2 / 0.5)).norm(), 1e-12);
+  EXPECT_NEAR(out[0], lim, 1e-12);
+  EXPECT_LT((out - tau / 2.5).norm(), 1e-12);
   EXPECT_LT(parallel_error(force_for_torque(pose_dh(), out),
                            force_for_torque(pose_dh(), tau)),
             1e-9);

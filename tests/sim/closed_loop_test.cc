@@ -16,6 +16,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "controller/omni_ratings.h"
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/thesis_cases.h"
 
@@ -65,6 +66,38 @@ TEST(ClosedLoopTest, TorqueIsHeldOverTheServoPeriod) {
   for (int i = 0; i < loop.substeps(); ++i) {
     mj_step(m, d);
     EXPECT_EQ(d->ctrl[a], held) << "substep " << i;
+  }
+}
+
+// torque_limits: the OpenHaptics samples' clamps by default (omni.xml's own
+// ranges), and with "rated" both the controller's clamp and the simulated
+// motors' range are the rated 0.44 N m, which a torque above the samples'
+// clamps then actually reaches (the hand pulls the RM 60 mm off the path,
+// where the law asks for more than either limit allows).
+TEST(ClosedLoopTest, TorqueLimitsReachTheSimulatedMotors) {
+  testing::MujocoGuard guard;
+  for (const char* which : {"openhaptics_samples", "rated"}) {
+    ClosedLoop loop(scene(1), {std::string("torque_limits=") + which});
+    const auto lim = loop.controller_params().omni.motor_torque_limit_Nm;
+    const auto expect = motor_torque_limits_Nm(OmniParams{}, parse_torque_limits(which));
+    EXPECT_EQ(lim, expect) << which;
+    const mjModel* m = loop.model();
+    double largest = 0.0;
+    TraceRow row;
+    for (int k = 0; k < loop.ticks_per_run(); ++k) {
+      loop.tick(&row);
+      largest = std::max(largest, row.motor_torque_Nm.cwiseAbs().maxCoeff());
+    }
+    for (int i = 0; i < 3; ++i) {
+      const int a = mj_name2id(m, mjOBJ_ACTUATOR, ("m" + std::to_string(i + 1)).c_str());
+      EXPECT_DOUBLE_EQ(m->actuator_ctrlrange[2 * a + 1], expect[static_cast<std::size_t>(i)])
+          << which << " m" << i + 1;
+    }
+    if (std::string(which) == "rated") {
+      EXPECT_GT(largest, 0.35 + 1e-3) << "no torque above the samples' clamps";
+    } else {
+      EXPECT_LE(largest, 0.35 + 1e-12);
+    }
   }
 }
 

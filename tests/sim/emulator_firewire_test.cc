@@ -310,14 +310,15 @@ TEST(EmulatorFirewire, TorqueThroughTheWireReachesTheMotors) {
 // estimate.
 TEST(EmulatorFirewire, TheFactoryScaleAndSignAreTheDevicesOwn) {
   EmulatorFirewireOptions o = options(HandProgram::kTour);
-  o.factory_full_scale_Nm = {0.28, 0.35, 0.35};
+  const double est = fw::kMotorFullScaleEstimate_Nm;  // what the host assumes
+  o.factory_full_scale_Nm = {0.8 * est, est, est};
   o.factory_motor_sign = {+1, -1, +1};
   EmulatorFirewireTransport t(o);
   fw::FirewireOmni omni(&t, omni_options(t));
   t.start();
   const Vec3 tau(0.1, 0.2, 0.05);
-  const Vec3 expected(0.1 * 0.28 / 0.35, -0.2, 0.05);
-  const double step_Nm = 0.35 / 2047.0;
+  const Vec3 expected(0.1 * 0.8, -0.2, 0.05);
+  const double step_Nm = est / 2047.0;
   Vec3 held = Vec3::Zero();
   EXPECT_TRUE(wait_for(
       [&] {

@@ -134,7 +134,7 @@ TEST_F(SimDeviceTest, WritesAreClampedToEachMotorsCtrlrange) {
   EXPECT_EQ(ctrl_of(m(), d()), Vec3(hi[0], lo[1], 0.01));
   EXPECT_EQ(dev.motor_torque_Nm(), ctrl_of(m(), d()));
 
-  EXPECT_EQ(dev.write_motor_torques(Vec3(-0.25, 0.36, -1.0)), DeviceError::kOk);
+  EXPECT_EQ(dev.write_motor_torques(Vec3(-0.5, 0.5, -1.0)), DeviceError::kOk);
   EXPECT_TRUE(dev.clamped());
   EXPECT_EQ(ctrl_of(m(), d()), Vec3(lo[0], hi[1], lo[2]));
 
