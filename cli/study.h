@@ -4,6 +4,8 @@
 //   vmhaptics study stability   K_crit of the sampled-data loop vs theory
 //   vmhaptics study extremes    stiff and extreme cases, with named outcomes
 //   vmhaptics study leanness    steps/s as composed vs with everything on
+//   vmhaptics study sensitivity how far each claim survives the model's
+//                               uncertainty (and `study merge` of its shards)
 // Each prints one JSON object on stdout and, with --out DIR, writes its
 // tables (CSV, units in the column names) and plots (SVG) under DIR.
 #ifndef VMHAPTICS_CLI_STUDY_H_
@@ -21,6 +23,8 @@ void register_study_precision(CLI::App* study);
 void register_study_stability(CLI::App* study);
 void register_study_extremes(CLI::App* study);
 void register_study_leanness(CLI::App* study);
+// sensitivity and merge (cli/study_sensitivity.cc)
+void register_study_sensitivity(CLI::App* study);
 
 }  // namespace vmh::cli
 

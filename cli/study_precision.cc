@@ -2,12 +2,15 @@
 //                           [--integrators euler,implicit,rk4]
 //                           [--reference-step S] [--reference-check-step S]
 //                           [--set name=value ...] [--out DIR]
+//                           [--modelling-spread sensitivity.json]
 //
 // Error of the stylus's trajectory against wall time, per MuJoCo integrator
 // and physics step (studies/precision_study.h). Prints one JSON object; with
 // --out writes DIR/precision.csv, DIR/precision.svg (error vs wall time) and
 // DIR/precision_order.svg (error vs h). Exit 2 on bad usage, naming the
-// option; nothing is written then.
+// option; nothing is written then. With --modelling-spread, the sensitivity
+// study's spread of the RMS path error for the same case is drawn across
+// precision.svg and compared with the default setting's error in the JSON.
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -34,6 +37,7 @@ struct PrecisionCli {
   double reference_check_step_s = studies::PrecisionOptions{}.reference_check_step_s;
   std::vector<std::string> sets;
   std::string out;
+  std::string modelling_spread;  // a sensitivity.json (or its folder)
 };
 
 std::string g(double x) {
@@ -93,6 +97,13 @@ studies::PrecisionOptions to_options(const PrecisionCli& o) {
   }
   p.overrides = o.sets;
   p.out_dir = o.out;
+  if (!o.modelling_spread.empty()) {
+    try {
+      p.modelling_spread = studies::read_modelling_spread(o.modelling_spread, p.name);
+    } catch (const sim::SimError& e) {
+      throw UsageError(std::string("--modelling-spread: ") + e.what());
+    }
+  }
   return p;
 }
 
@@ -179,6 +190,10 @@ void register_study_precision(CLI::App* study) {
       ->allow_extra_args(false);
   cmd->add_option("--out", o->out,
                   "write DIR/precision.csv, precision.svg, precision_order.svg");
+  cmd->add_option("--modelling-spread", o->modelling_spread,
+                  "a sensitivity.json (or its folder) of the same case: its "
+                  "spread of the RMS path error is drawn across precision.svg "
+                  "and compared with the default setting's error");
   cmd->callback([o] { run(*o); });
 }
 

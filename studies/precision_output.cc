@@ -134,6 +134,13 @@ nlohmann::ordered_json precision_json(const PrecisionResult& r) {
       {"rows", rows},
       {"study_wall_time_s", r.study_wall_time_s},
   };
+  if (r.modelling_spread.present) {
+    double default_error = std::nan("");
+    for (const PrecisionRow& row : r.rows) {
+      if (row.is_default) default_error = row.error.rms_mm;
+    }
+    j["modelling_spread"] = modelling_spread_json(r.modelling_spread, default_error);
+  }
   if (!r.files.empty()) j["files"] = r.files;
   return j;
 }

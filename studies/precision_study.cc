@@ -434,6 +434,7 @@ PrecisionResult run_precision_study(const PrecisionOptions& o) {
   r.name = o.name;
   r.scene = o.scene;
   r.duration_s = o.duration_s;
+  r.modelling_spread = o.modelling_spread;
 
   // every check before the first run
   probe_scene(o, &r);
@@ -544,6 +545,7 @@ report::Chart precision_chart(const PrecisionResult& r) {
     s.y = {r.reference.self_error.rms_mm, r.reference.self_error.rms_mm};
     c.series.push_back(s);
   }
+  add_modelling_spread(&c, r.modelling_spread);
   return c;
 }
 

@@ -28,6 +28,7 @@
 #include "sim/hand_script.h"
 #include "report/progress.h"
 #include "report/svg_chart.h"
+#include "studies/modelling_spread.h"
 
 namespace vmh::studies {
 
@@ -65,6 +66,9 @@ struct PrecisionOptions {
   // called with (runs done, runs) after the references (one item) and after
   // each rung of the ladder; not set: nothing
   report::ProgressFn progress;
+  // the sensitivity study's spread of the RMS path error, shown beside the
+  // errors (precision.svg, the JSON's modelling_spread); not present: none
+  ModellingSpread modelling_spread;
 };
 
 // How one run differs from the reference, tick by tick.
@@ -137,6 +141,7 @@ struct PrecisionResult {
   double floor_mm = 0.0;           // rungs below this are not fitted
   double study_wall_time_s = 0.0;
   std::vector<std::string> files;  // the paths written (out_dir)
+  ModellingSpread modelling_spread;  // the options', if present
 };
 
 // a rung is fitted when its rms error is above this many times the

@@ -1,0 +1,635 @@
+// The sensitivity study's outputs: sensitivity.json (the sweep, its points,
+// per claim what it depends on, the modelling spread), sensitivity.csv, the
+// figure, and the partial files of shards with their merge.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "report/output_file.h"
+#include "studies/sensitivity_study.h"
+
+namespace vmh::studies {
+namespace {
+
+using Json = nlohmann::ordered_json;
+using sim::SimError;
+namespace fs = std::filesystem;
+
+Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(); }
+double number_from(const nlohmann::json& j) {
+  return j.is_number() ? j.get<double>() : std::nan("");
+}
+
+Json value_json(const SweepValue& v) {
+  return v.text.empty() ? Json(v.number) : Json(v.text);
+}
+
+const char* kind_name(SweepKind k) {
+  switch (k) {
+    case SweepKind::kField: return "case_field";
+    case SweepKind::kFieldScale: return "case_field_scale";
+    case SweepKind::kOmniMass: return "omni_mass_scale";
+    case SweepKind::kOmniFriction: return "omni_friction_scale";
+    case SweepKind::kChoice: return "case_field_choice";
+  }
+  return "?";
+}
+const char* scale_name(SweepScale s) {
+  switch (s) {
+    case SweepScale::kLinear: return "linear";
+    case SweepScale::kLog: return "log";
+    case SweepScale::kInteger: return "integer";
+    case SweepScale::kChoice: return "choice";
+  }
+  return "?";
+}
+bool parse_kind(const std::string& s, SweepKind* k) {
+  for (SweepKind x : {SweepKind::kField, SweepKind::kFieldScale,
+                      SweepKind::kOmniMass, SweepKind::kOmniFriction,
+                      SweepKind::kChoice}) {
+    if (s == kind_name(x)) { *k = x; return true; }
+  }
+  return false;
+}
+bool parse_scale(const std::string& s, SweepScale* k) {
+  for (SweepScale x : {SweepScale::kLinear, SweepScale::kLog,
+                       SweepScale::kInteger, SweepScale::kChoice}) {
+    if (s == scale_name(x)) { *k = x; return true; }
+  }
+  return false;
+}
+
+Json parameter_json(const SweepParameter& p) {
+  Json j = {{"name", p.name},
+            {"kind", kind_name(p.kind)},
+            {"field", p.field.empty() ? Json() : Json(p.field)},
+            {"scale", scale_name(p.scale)}};
+  if (p.scale == SweepScale::kChoice) {
+    j["choices"] = p.choices;
+  } else {
+    j["low"] = p.low;
+    j["high"] = p.high;
+  }
+  j["unit"] = p.unit;
+  j["source"] = p.source;
+  j["optional"] = p.optional;
+  return j;
+}
+
+SweepParameter parameter_from(const nlohmann::json& j) {
+  SweepParameter p;
+  p.name = j.at("name").get<std::string>();
+  if (!parse_kind(j.at("kind").get<std::string>(), &p.kind) ||
+      !parse_scale(j.at("scale").get<std::string>(), &p.scale)) {
+    throw std::runtime_error("parameter " + p.name + ": unknown kind or scale");
+  }
+  if (j.at("field").is_string()) p.field = j.at("field").get<std::string>();
+  if (p.scale == SweepScale::kChoice) {
+    p.choices = j.at("choices").get<std::vector<std::string>>();
+  } else {
+    p.low = j.at("low").get<double>();
+    p.high = j.at("high").get<double>();
+  }
+  p.unit = j.at("unit").get<std::string>();
+  p.source = j.at("source").get<std::string>();
+  p.optional = j.at("optional").get<bool>();
+  return p;
+}
+
+// one case's claim as the sweep saw it
+struct ClaimView {
+  std::string name;
+  std::string unit, comparison;
+  double threshold = 0.0;
+};
+
+const ClaimOutcome* find_claim(const PointResult& r, const std::string& name) {
+  for (const ClaimOutcome& c : r.claims) {
+    if (c.name == name) return &c;
+  }
+  return nullptr;
+}
+
+bool holds(const PointResult& r, const std::string& name) {
+  const ClaimOutcome* c = find_claim(r, name);
+  return r.error.empty() && c != nullptr && c->pass;
+}
+
+// the points of one case, by kind
+struct CasePoints {
+  std::size_t nominal = 0;
+  std::vector<std::vector<std::size_t>> by_parameter;  // one at a time
+  std::vector<std::size_t> sample;
+};
+
+CasePoints case_points(const SweepPlan& plan, std::size_t ci) {
+  CasePoints cp;
+  cp.by_parameter.resize(plan.parameters.size());
+  for (const SweepPoint& pt : plan.points) {
+    if (pt.case_index != ci) continue;
+    switch (pt.kind) {
+      case PointKind::kNominal: cp.nominal = pt.index; break;
+      case PointKind::kOneAtATime:
+        cp.by_parameter[static_cast<std::size_t>(pt.parameter)].push_back(pt.index);
+        break;
+      case PointKind::kSample: cp.sample.push_back(pt.index); break;
+    }
+  }
+  return cp;
+}
+
+// the claims of a case, in the order its points first name them
+std::vector<ClaimView> case_claims(const SweepPlan& plan, std::size_t ci,
+                                   const std::vector<PointResult>& results) {
+  std::vector<ClaimView> out;
+  for (const SweepPoint& pt : plan.points) {
+    if (pt.case_index != ci) continue;
+    for (const ClaimOutcome& c : results[pt.index].claims) {
+      const bool known = std::any_of(out.begin(), out.end(), [&](const ClaimView& v) {
+        return v.name == c.name;
+      });
+      if (!known) out.push_back({c.name, c.unit, c.comparison, c.threshold});
+    }
+  }
+  return out;
+}
+
+double fraction_holding(const std::vector<std::size_t>& points,
+                        const std::vector<PointResult>& results,
+                        const std::string& claim) {
+  if (points.empty()) return std::nan("");
+  std::size_t n = 0;
+  for (std::size_t i : points) n += holds(results[i], claim) ? 1 : 0;
+  return static_cast<double>(n) / static_cast<double>(points.size());
+}
+
+// min and max of the finite values
+struct Range {
+  double lo = std::nan(""), hi = std::nan("");
+  void add(double x) {
+    if (!std::isfinite(x)) return;
+    lo = std::isfinite(lo) ? std::min(lo, x) : x;
+    hi = std::isfinite(hi) ? std::max(hi, x) : x;
+  }
+  double span() const { return std::isfinite(lo) ? hi - lo : 0.0; }
+  Json json() const { return Json::array({number_or_null(lo), number_or_null(hi)}); }
+};
+
+// a level's distance from the nominal on the parameter's own scale, 0..1
+// of the range (choices: their order)
+double distance(const SweepParameter& p, const SweepValue& v,
+                const SweepValue& nominal) {
+  if (p.scale == SweepScale::kChoice) return 0.0;
+  if (p.scale == SweepScale::kLog && v.number > 0.0 && nominal.number > 0.0) {
+    return std::abs(std::log(v.number / nominal.number)) /
+           std::log(p.high / p.low);
+  }
+  return p.high > p.low ? std::abs(v.number - nominal.number) / (p.high - p.low)
+                        : 0.0;
+}
+
+struct ParameterEffect {
+  std::size_t parameter = 0;
+  double holds_fraction = 0.0;
+  Range value, margin;
+  std::vector<SweepValue> flipped;  // levels where the verdict differs
+  SweepValue flips_at;              // the one nearest the nominal
+};
+
+}  // namespace
+
+nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
+                                        const std::vector<PointResult>& results) {
+  Json params = Json::array();
+  for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
+    Json p = parameter_json(plan.parameters[j]);
+    p.erase("optional");
+    Json nominal = Json::object();
+    for (const SweepCase& c : plan.cases) nominal[c.name] = value_json(c.nominal[j]);
+    p["nominal"] = nominal;
+    params.push_back(p);
+  }
+  Json cases = Json::array();
+  for (const SweepCase& c : plan.cases) {
+    cases.push_back({{"name", c.name}, {"scene", c.scene},
+                     {"physics_step_s", c.physics_step_s}});
+  }
+
+  Json points = Json::array();
+  for (const SweepPoint& pt : plan.points) {
+    const PointResult& r = results[pt.index];
+    Json values = Json::object();
+    for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
+      values[plan.parameters[j].name] = value_json(pt.values[j]);
+    }
+    Json claims = Json::object();
+    for (const ClaimOutcome& c : r.claims) {
+      claims[c.name] = {{"value", number_or_null(c.value)},
+                        {"margin", number_or_null(claim_margin(c))},
+                        {"pass", c.pass}};
+    }
+    points.push_back(
+        {{"index", pt.index},
+         {"case", plan.cases[pt.case_index].name},
+         {"kind", point_kind_name(pt.kind)},
+         {"parameter", pt.parameter < 0 ? Json()
+                                        : Json(plan.parameters[static_cast<std::size_t>(pt.parameter)].name)},
+         {"values", values},
+         {"set", pt.overrides},
+         {"rms_path_error_mm", number_or_null(r.rms_path_error_mm)},
+         {"error", r.error.empty() ? Json() : Json(r.error)},
+         {"claims", claims}});
+  }
+
+  Json claims = Json::array();
+  Json spreads = Json::array();
+  for (std::size_t ci = 0; ci < plan.cases.size(); ++ci) {
+    const SweepCase& c = plan.cases[ci];
+    const CasePoints cp = case_points(plan, ci);
+    std::vector<std::size_t> oat = {cp.nominal};
+    for (const auto& v : cp.by_parameter) oat.insert(oat.end(), v.begin(), v.end());
+    const bool sampled = !cp.sample.empty();
+    const std::vector<std::size_t>& over = sampled ? cp.sample : oat;
+
+    for (const ClaimView& cv : case_claims(plan, ci, results)) {
+      const PointResult& nom = results[cp.nominal];
+      const ClaimOutcome* nc = find_claim(nom, cv.name);
+      const bool nominal_holds = holds(nom, cv.name);
+      std::vector<ParameterEffect> effects;
+      for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
+        ParameterEffect e;
+        e.parameter = j;
+        std::vector<std::size_t> pts = {cp.nominal};
+        pts.insert(pts.end(), cp.by_parameter[j].begin(), cp.by_parameter[j].end());
+        e.holds_fraction = fraction_holding(pts, results, cv.name);
+        double best = INFINITY;
+        for (std::size_t i : pts) {
+          const ClaimOutcome* o = find_claim(results[i], cv.name);
+          if (o != nullptr) {
+            e.value.add(o->value);
+            e.margin.add(claim_margin(*o));
+          }
+          if (i == cp.nominal || holds(results[i], cv.name) == nominal_holds) {
+            continue;
+          }
+          const SweepValue& v = plan.points[i].values[j];
+          e.flipped.push_back(v);
+          const double d = distance(plan.parameters[j], v, c.nominal[j]);
+          if (d < best) {
+            best = d;
+            e.flips_at = v;
+          }
+        }
+        effects.push_back(e);
+      }
+      Json by_parameter = Json::array();
+      for (const ParameterEffect& e : effects) {
+        by_parameter.push_back({{"parameter", plan.parameters[e.parameter].name},
+                                {"holds_fraction", number_or_null(e.holds_fraction)},
+                                {"value_range", e.value.json()},
+                                {"margin_range", e.margin.json()}});
+      }
+      std::vector<ParameterEffect> deciding;
+      for (const ParameterEffect& e : effects) {
+        if (!e.flipped.empty()) deciding.push_back(e);
+      }
+      std::stable_sort(deciding.begin(), deciding.end(),
+                       [](const ParameterEffect& a, const ParameterEffect& b) {
+                         return a.margin.span() > b.margin.span();
+                       });
+      Json depends_on = Json::array();
+      for (const ParameterEffect& e : deciding) {
+        Json levels = Json::array();
+        for (const SweepValue& v : e.flipped) levels.push_back(value_json(v));
+        depends_on.push_back({{"parameter", plan.parameters[e.parameter].name},
+                              {"flips_at", value_json(e.flips_at)},
+                              {"flipped_at", levels},
+                              {"value_range", e.value.json()},
+                              {"margin_range", e.margin.json()}});
+      }
+      claims.push_back(
+          {{"case", c.name},
+           {"name", cv.name},
+           {"unit", cv.unit},
+           {"comparison", cv.comparison},
+           {"threshold", cv.threshold},
+           {"value_at_nominal", nc != nullptr ? number_or_null(nc->value) : Json()},
+           {"holds_at_nominal", nominal_holds},
+           {"holds_fraction", number_or_null(fraction_holding(over, results, cv.name))},
+           {"holds_fraction_over", sampled ? "sample" : "one_at_a_time"},
+           {"holds_fraction_one_at_a_time",
+            number_or_null(fraction_holding(oat, results, cv.name))},
+           {"holds_fraction_sample",
+            sampled ? number_or_null(fraction_holding(cp.sample, results, cv.name))
+                    : Json()},
+           {"depends_on", depends_on},
+           {"by_parameter", by_parameter}});
+    }
+
+    // the modelling spread of the RMS path error
+    Range all;
+    for (std::size_t i : over) all.add(results[i].rms_path_error_mm);
+    Json by_parameter = Json::array();
+    std::vector<std::pair<double, Json>> ranked;
+    for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
+      Range r;
+      r.add(results[cp.nominal].rms_path_error_mm);
+      for (std::size_t i : cp.by_parameter[j]) r.add(results[i].rms_path_error_mm);
+      ranked.push_back({r.span(), Json{{"parameter", plan.parameters[j].name},
+                                       {"range_mm", r.json()},
+                                       {"spread_mm", r.span()}}});
+    }
+    std::stable_sort(ranked.begin(), ranked.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (auto& r : ranked) by_parameter.push_back(r.second);
+    spreads.push_back(
+        {{"case", c.name},
+         {"rms_path_error_mm",
+          {{"nominal", number_or_null(results[cp.nominal].rms_path_error_mm)},
+           {"min", number_or_null(all.lo)},
+           {"max", number_or_null(all.hi)},
+           {"spread", all.span()},
+           {"over", sampled ? "sample" : "one_at_a_time"},
+           {"points", over.size()}}},
+         {"by_parameter", by_parameter}});
+  }
+
+  std::size_t failed = 0;
+  for (const PointResult& r : results) failed += r.error.empty() ? 0 : 1;
+  return {{"study", "sensitivity"},
+          {"software", plan.options.software},
+          {"sweep_id", plan.id},
+          {"cases", cases},
+          {"quick", plan.options.quick},
+          {"levels", plan.options.levels},
+          {"samples", plan.options.samples},
+          {"seed", plan.options.seed},
+          {"set", plan.options.overrides},
+          {"parameters", params},
+          {"omitted", plan.omitted},
+          {"point_count", plan.points.size()},
+          {"failed_points", failed},
+          {"claims", claims},
+          {"modelling_spread", spreads},
+          {"points", points}};
+}
+
+std::string sensitivity_csv(const SweepPlan& plan,
+                            const std::vector<PointResult>& results) {
+  std::ostringstream s;
+  s.precision(9);
+  s << "point,case,kind,parameter";
+  for (const SweepParameter& p : plan.parameters) s << ',' << p.name;
+  s << ",rms_path_error_mm,claim,claim_value,claim_unit,comparison,threshold,"
+       "margin_rel,holds,error\n";
+  for (const SweepPoint& pt : plan.points) {
+    const PointResult& r = results[pt.index];
+    std::ostringstream head;
+    head.precision(9);
+    head << pt.index << ',' << plan.cases[pt.case_index].name << ','
+         << point_kind_name(pt.kind) << ','
+         << (pt.parameter < 0 ? "" : plan.parameters[static_cast<std::size_t>(pt.parameter)].name);
+    for (const SweepValue& v : pt.values) {
+      if (v.text.empty()) head << ',' << v.number; else head << ',' << v.text;
+    }
+    head << ',' << r.rms_path_error_mm;
+    std::string error = r.error;
+    std::replace(error.begin(), error.end(), ',', ';');
+    std::replace(error.begin(), error.end(), '\n', ' ');
+    if (r.claims.empty()) {
+      s << head.str() << ",,,,,,,0," << error << '\n';
+    }
+    for (const ClaimOutcome& c : r.claims) {
+      s << head.str() << ',' << c.name << ',' << c.value << ',' << c.unit << ','
+        << c.comparison << ',' << c.threshold << ',' << claim_margin(c) << ','
+        << (c.pass ? 1 : 0) << ',' << error << '\n';
+    }
+  }
+  return s.str();
+}
+
+report::ChartGrid sensitivity_chart(const SweepPlan& plan,
+                                    const std::vector<PointResult>& results) {
+  report::ChartGrid grid;
+  grid.title = "Sensitivity: each claim's margin over each parameter's range, "
+               "the others nominal";
+  grid.notes = {
+      "margin = (value - threshold)/|threshold| for >=, (threshold - value)/|threshold| "
+      "for <=; >= 0 holds. A bar spans the margins over one parameter's levels; the dot "
+      "is the nominal.",
+      "sweep " + plan.id + ", " + plan.options.software};
+  grid.columns = 2;
+  for (std::size_t ci = 0; ci < plan.cases.size(); ++ci) {
+    const CasePoints cp = case_points(plan, ci);
+    for (const ClaimView& cv : case_claims(plan, ci, results)) {
+      report::Chart ch;
+      ch.title = plan.cases[ci].name + " " + cv.name;
+      ch.x.label = "parameter (legend order)";
+      ch.y.label = "claim margin (relative)";
+      ch.width_px = 560;
+      ch.height_px = 420;
+      const ClaimOutcome* nc = find_claim(results[cp.nominal], cv.name);
+      const double nominal_margin = nc ? claim_margin(*nc) : std::nan("");
+      for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
+        Range r;
+        r.add(nominal_margin);
+        for (std::size_t i : cp.by_parameter[j]) {
+          if (const ClaimOutcome* o = find_claim(results[i], cv.name)) {
+            r.add(claim_margin(*o));
+          }
+        }
+        report::ChartSeries s;
+        s.label = plan.parameters[j].name;
+        const double x = static_cast<double>(j + 1);
+        s.x = {x, x};
+        s.y = {r.lo, r.hi};
+        ch.series.push_back(s);
+      }
+      report::ChartSeries zero;
+      zero.label = "holds above 0";
+      zero.x = {0.5, plan.parameters.size() + 0.5};
+      zero.y = {0.0, 0.0};
+      zero.color = "#000000";
+      zero.dashed = true;
+      zero.markers = false;
+      ch.series.push_back(zero);
+      report::ChartSeries nom;
+      nom.label = "nominal";
+      for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
+        nom.x.push_back(static_cast<double>(j + 1));
+        nom.y.push_back(nominal_margin);
+      }
+      nom.line = false;
+      nom.color = "#000000";
+      ch.series.push_back(nom);
+      grid.panels.push_back(ch);
+    }
+  }
+  return grid;
+}
+
+std::vector<std::string> write_sensitivity_files(
+    const SweepPlan& plan, const std::vector<PointResult>& results,
+    const std::string& out_dir) {
+  const std::string svg = report::chart_grid_svg(sensitivity_chart(plan, results));
+  return {report::write_file_in(out_dir, "sensitivity.json",
+                                sensitivity_json(plan, results).dump(2) + "\n"),
+          report::write_file_in(out_dir, "sensitivity.csv",
+                                sensitivity_csv(plan, results)),
+          report::write_file_in(out_dir, "sensitivity.svg", svg)};
+}
+
+nlohmann::ordered_json partial_json(const SweepPlan& plan, int k, int n,
+                                    const std::vector<PointResult>& results) {
+  const SensitivityOptions& o = plan.options;
+  Json table = Json();
+  if (!o.parameters.empty()) {
+    table = Json::array();
+    for (const SweepParameter& p : o.parameters) table.push_back(parameter_json(p));
+  }
+  Json rs = Json::array();
+  for (const PointResult& r : results) {
+    Json claims = Json::array();
+    for (const ClaimOutcome& c : r.claims) {
+      claims.push_back({{"name", c.name}, {"value", number_or_null(c.value)},
+                        {"threshold", c.threshold}, {"comparison", c.comparison},
+                        {"unit", c.unit}, {"pass", c.pass}});
+    }
+    rs.push_back({{"index", r.index},
+                  {"error", r.error},
+                  {"rms_path_error_mm", number_or_null(r.rms_path_error_mm)},
+                  {"claims", claims}});
+  }
+  return {{"study", "sensitivity-partial"},
+          {"software", o.software},
+          {"sweep_id", plan.id},
+          {"shard", {{"k", k}, {"n", n}}},
+          {"point_count", plan.points.size()},
+          {"options",
+           {{"cases", o.cases},
+            {"quick", o.quick},
+            {"levels", o.levels},
+            {"samples", o.samples},
+            {"seed", o.seed},
+            {"set", o.overrides},
+            {"parameters", table}}},
+          {"results", rs}};
+}
+
+std::string write_partial_file(const SweepPlan& plan, int k, int n,
+                               const std::vector<PointResult>& results,
+                               const std::string& out_dir) {
+  return report::write_file_in(out_dir, "sensitivity.partial.json",
+                               partial_json(plan, k, n, results).dump(2) + "\n");
+}
+
+SensitivityOptions partial_options(const nlohmann::json& partial,
+                                   const std::string& where) {
+  try {
+    if (partial.at("study") != "sensitivity-partial") {
+      throw std::runtime_error("not a sensitivity.partial.json");
+    }
+    const nlohmann::json& o = partial.at("options");
+    SensitivityOptions s;
+    s.cases = o.at("cases").get<std::vector<std::string>>();
+    s.quick = o.at("quick").get<bool>();
+    s.levels = o.at("levels").get<int>();
+    s.samples = o.at("samples").get<int>();
+    s.seed = o.at("seed").get<std::uint64_t>();
+    s.overrides = o.at("set").get<std::vector<std::string>>();
+    if (o.at("parameters").is_array()) {
+      for (const auto& p : o.at("parameters")) s.parameters.push_back(parameter_from(p));
+    }
+    s.software = partial.at("software").get<std::string>();
+    return s;
+  } catch (const std::exception& e) {
+    throw SimError(where + ": not a sensitivity shard's file (" + e.what() + ")");
+  }
+}
+
+std::vector<PointResult> partial_results(const nlohmann::json& partial,
+                                         const std::string& where) {
+  std::vector<PointResult> out;
+  try {
+    for (const auto& r : partial.at("results")) {
+      PointResult p;
+      p.index = r.at("index").get<std::size_t>();
+      p.error = r.at("error").get<std::string>();
+      p.rms_path_error_mm = number_from(r.at("rms_path_error_mm"));
+      for (const auto& c : r.at("claims")) {
+        p.claims.push_back({c.at("name").get<std::string>(), number_from(c.at("value")),
+                            c.at("threshold").get<double>(),
+                            c.at("comparison").get<std::string>(),
+                            c.at("unit").get<std::string>(), c.at("pass").get<bool>()});
+      }
+      out.push_back(p);
+    }
+  } catch (const std::exception& e) {
+    throw SimError(where + ": a result that cannot be read (" + e.what() + ")");
+  }
+  return out;
+}
+
+Merged merge_partials(const std::vector<std::string>& paths,
+                      const std::string& software) {
+  if (paths.empty()) throw SimError("merge: no partial files given");
+  std::vector<std::pair<std::string, nlohmann::json>> files;
+  for (const std::string& given : paths) {
+    std::string path = given;
+    if (fs::is_directory(path)) path = (fs::path(path) / "sensitivity.partial.json").string();
+    std::ifstream in(path);
+    if (!in) throw SimError(path + ": cannot read");
+    nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded()) throw SimError(path + ": not JSON");
+    files.emplace_back(path, std::move(j));
+  }
+  SensitivityOptions options = partial_options(files[0].second, files[0].first);
+  const std::string first_software = options.software;
+  options.software = software;
+  Merged m;
+  m.plan = plan_sweep(options);
+  std::vector<bool> seen(m.plan.points.size(), false);
+  m.results.resize(m.plan.points.size());
+  for (const auto& [path, j] : files) {
+    partial_options(j, path);  // the same checks on every file
+    const std::string id = j.value("sweep_id", std::string());
+    if (id != m.plan.id) {
+      throw SimError(path + ": sweep " + id + " is not the sweep " + m.plan.id +
+                     " that " + files[0].first + " describes (planned again by " +
+                     software + "; the file was written by " +
+                     j.value("software", std::string("?")) + ", the first by " +
+                     first_software + ")");
+    }
+    for (PointResult& r : partial_results(j, path)) {
+      if (r.index >= seen.size()) {
+        throw SimError(path + ": point " + std::to_string(r.index) + " is not in the sweep");
+      }
+      if (seen[r.index]) {
+        throw SimError(path + ": point " + std::to_string(r.index) +
+                       " is given twice (the same shard merged twice?)");
+      }
+      seen[r.index] = true;
+      m.results[r.index] = std::move(r);
+    }
+  }
+  std::string missing;
+  std::size_t n_missing = 0;
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    if (seen[i]) continue;
+    if (++n_missing <= 5) missing += " " + std::to_string(i);
+  }
+  if (n_missing > 0) {
+    throw SimError("merge: " + std::to_string(n_missing) + " of " +
+                   std::to_string(seen.size()) + " points missing (" +
+                   missing.substr(1) + (n_missing > 5 ? " ..." : "") +
+                   "): a shard was not given");
+  }
+  return m;
+}
+
+}  // namespace vmh::studies
