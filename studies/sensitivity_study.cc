@@ -212,31 +212,36 @@ const std::vector<SweepParameter>& sweep_parameters() {
     std::vector<SweepParameter> t = {
         row("hand_k_pos_N_per_m", K::kField, "hand_k_pos_N_per_m", S::kLog,
             50, 400, "N/m",
-            "grasp stiffness of the arm and hand: 50-400 N/m spans light to "
-            "firm grips (Hajian & Howe 1997; Kuchenbecker, Park & Niemeyer "
-            "2003); the pen grip's own values are being sourced (issue 16)"),
+            "a stylus in a pen grip reduced to one stage: 65, 88, 201 N/m "
+            "along x, y, z, 49-353 over the 95% intervals (Fu & Cavusoglu "
+            "2012, via a secondary table; docs/sources.md 10.1)"),
         row("hand_b_pos_Ns_per_m", K::kField, "hand_b_pos_Ns_per_m", S::kLog,
-            2, 15, "N s/m",
-            "grasp damping, same sources and grips as the stiffness"),
+            2, 16, "N s/m",
+            "the same reduction: 3.2-9.9 N s/m, about 2.5-16 over the "
+            "intervals; Israr, Choi & Tan 2006 give 12.6-15.8 along a pen-"
+            "held stylus (docs/sources.md 10.1)"),
         row("hand_mass_kg", K::kField, "hand_mass_kg", S::kLog, 0.1, 0.6,
             "kg",
-            "mass coupled at the grip: fingers and hand (0.1 kg) to hand and "
-            "forearm (0.6 kg; van Beek et al. 2015 give 0.554)"),
+            "mass coupled at the grip: 0.14-0.57 kg over the pen grip's "
+            "intervals (Fu & Cavusoglu 2012); one trial of van Beek et al. "
+            "2015 gives 0.554 (docs/sources.md 10, 10.1)"),
         row("hand_inertia_scale", K::kFieldScale, "hand_inertia_kgm2",
             S::kLog, 0.5, 2.0, "x",
             "estimate: the case's hand inertia halved to doubled, no "
-            "pen-grip measurement at hand"),
+            "pen-grip measurement found"),
         row("hand_k_rot_Nm_per_rad", K::kField, "hand_k_rot_Nm_per_rad",
             S::kLog, 0.05, 2.0, "N m/rad",
-            "wrist and fingers' rotational stiffness, relaxed to co-"
-            "contracted (Kuchenbecker, Park & Niemeyer 2003 for the wrist)"),
+            "derived, not measured: roll of a pen grip 0.075-0.16, tilt "
+            "0.4-0.6, a relaxed wrist 1.2-1.8 N m/rad (Formica et al. "
+            "2012); docs/sources.md 10.1"),
         row("hand_b_rot_Nms_per_rad", K::kField, "hand_b_rot_Nms_per_rad",
             S::kLog, 0.005, 0.05, "N m s/rad",
-            "wrist rotational damping, same sources"),
+            "estimate: a decade around the case's value; no measured "
+            "rotational damping of a pen grip was found"),
         row("omni_mass_scale", K::kOmniMass, "", S::kLinear, 0.7, 1.3, "x",
             "every Omni link's mass and inertia x0.7-1.3: the model's "
-            "masses are estimates from CAD and teardown photos "
-            "(docs/omni.md), not weighed"),
+            "masses are scaled from a PHANTOM Premium 1.5 model, not "
+            "weighed (docs/sources.md 8)"),
         row("omni_friction_scale", K::kOmniFriction, "", S::kLinear, 0.0,
             2.0, "x",
             "the Omni joints' dry friction x0-2: none to twice the "
