@@ -163,6 +163,44 @@ ProjectionResult project_motion_force(const VmJacobian& J, const Vec6& W_A,
     return result;
   }
   const auto WA = W_A.asDiagonal();
+  if (m == 1 && projector == nullptr) {
+    // the circle: J^T W_A J is a scalar, its own eigenvalue with
+    // eigenvector 1; the same regularised inverse without the solver
+    const auto j = J.col(0);
+    const double s = j.dot(W_A.cwiseProduct(j));
+    const double s_max = std::max(s, 0.0);
+    result.rcond = s_max > 0.0 ? 1.0 : 0.0;
+    result.singular = !(result.rcond >= singular_rcond);
+    const double rho = damping * s_max;
+    const double den = s_max * s_max + rho * rho;
+    const double inv_s = den > 0.0 ? s_max / den : 0.0;
+    *f = g - W_A.cwiseProduct(j) * (inv_s * j.dot(g));
+    return result;
+  }
+  if (m == 3 && projector == nullptr) {
+    // the sphere: the same steps on fixed-size 3 x 3 matrices, which Eigen
+    // tridiagonalises in closed form instead of by Householder reflections
+    const Eigen::Matrix<double, 6, 3> J3 = J;
+    const Mat3 A = J3.transpose() * WA * J3;
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(A);
+    const Vec3& s = eig.eigenvalues();  // ascending
+    const double s_max = std::max(s[2], 0.0);
+    const double s_min = std::max(s[0], 0.0);
+    result.rcond = s_max > 0.0 ? s_min / s_max : 0.0;
+    result.singular = !(result.rcond >= singular_rcond);
+    const double rho = damping * s_max;
+    Vec3 inv_s;
+    for (int i = 0; i < 3; ++i) {
+      const double si = std::max(s[i], 0.0);
+      const double den = si * si + rho * rho;
+      inv_s[i] = den > 0.0 ? si / den : 0.0;
+    }
+    const Vec3 x = J3.transpose() * g;
+    const Vec3 y = (eig.eigenvectors().transpose() * x).cwiseProduct(inv_s);
+    const Vec3 z = eig.eigenvectors() * y;
+    *f = g - WA * (J3 * z);
+    return result;
+  }
   SmallSquare A;
   A.noalias() = J.transpose() * WA * J;
   // A is symmetric positive semi-definite and at most 5 x 5

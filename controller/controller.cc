@@ -205,9 +205,8 @@ ControlStatus Controller::place(const RmPose& rm, JointMask locked,
   if (params_.placement == PlacementMethod::kClosedForm) {
     if (seed_ok) theta_v_ = seed_;
     out->placement_iterations = 0;
-    const Vec6 r = placement_residual(*vm_, rm, theta_v_);
-    out->placement_cost =
-        r.dot(params_.placement_options.weights.cwiseProduct(r));
+    // r^T W r at theta_V: evaluate() computes it from the pose it needs
+    // anyway (closed_form_cost)
     return st;
   }
   if (seed_ok) {
@@ -235,6 +234,9 @@ ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
   ControlStatus st = place(rm, locked, out);
   const double u = params_.length_unit_mm;
   const VmPose vm_pose = vm_->pose(theta_v_);
+  if (params_.placement == PlacementMethod::kClosedForm) {
+    out->placement_cost = closed_form_cost(vm_pose, rm);
+  }
   out->x_v_mm = vm_pose.p * u;
   out->x_r_mm = vm_->pose(theta_r_).p * u;
   // eq. 3.9: e = X_V - X_R
@@ -278,11 +280,26 @@ ControlStatus Controller::fail_input(ControlOutput* out) noexcept {
   return out->status;
 }
 
-RmPose Controller::rm_pose(const Joints& q_dh, ControlOutput* out) const noexcept {
+double Controller::closed_form_cost(const VmPose& vm_pose,
+                                    const RmPose& rm) const noexcept {
+  // placement_residual's r^T W r at theta_V, from the pose already computed;
+  // the orientation rows (an atan2) only where W weighs them, as they would
+  // add exactly 0 otherwise
+  const Vec6& w = params_.placement_options.weights;
+  const Vec3 r_p = rm.p - vm_pose.p;
+  double cost = r_p.dot(w.head<3>().cwiseProduct(r_p));
+  if ((w.tail<3>().array() != 0.0).any()) {
+    const Vec3 r_o = -vm_->geometric_orientation_error(vm_pose, rm, nullptr);
+    cost += r_o.dot(w.tail<3>().cwiseProduct(r_o));
+  }
+  return cost;
+}
+
+RmPose Controller::rm_pose(const OmniArmKinematics& arm,
+                           ControlOutput* out) const noexcept {
   const OmniParams& omni = params_.omni;
-  const OmniPose pose = omni_fk(omni, q_dh);
-  out->p_rm_mm = base_to_device_mm(omni, pose.p_base_m);
-  out->axis_rm = base_to_device_vector(pose.R_base.col(2));
+  out->p_rm_mm = base_to_device_mm(omni, arm.p_base_m);
+  out->axis_rm = base_to_device_vector(arm.z6_base);
   RmPose rm;
   rm.p = out->p_rm_mm / params_.length_unit_mm;
   rm.axis = out->axis_rm;
@@ -319,7 +336,7 @@ ControlStatus Controller::evaluate_with_contact(const RmPose& rm,
   return st;
 }
 
-ControlStatus Controller::saturate_and_map(const Joints& q_dh,
+ControlStatus Controller::saturate_and_map(const Mat3& Jv_arm,
                                            ControlOutput* out) const noexcept {
   ControlStatus st = kStatusOk;
   const OmniParams& omni = params_.omni;
@@ -332,8 +349,7 @@ ControlStatus Controller::saturate_and_map(const Joints& q_dh,
   // eq. 3.12 with the wrist-centre Jacobian's linear rows (m/rad) and the
   // force in the base frame: tau in N m
   Vec3 F_base = device_to_base_vector(F);
-  const Mat6 Jr = omni_jacobian(omni, q_dh);
-  Vec3 tau = Jr.topLeftCorner<3, 3>().transpose() * F_base;
+  Vec3 tau = Jv_arm.transpose() * F_base;
   Vec3 tau_motor = dh_to_motor_torques(tau);
   // one scale for every motor over its limit keeps the force's direction
   double scale = 1.0;
@@ -367,8 +383,10 @@ ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept 
   ControlStatus st = kStatusOk;
   if (!omni_within_limits(params_.omni, q_dh)) st |= kStatusOutsideJointLimits;
 
-  // 1. the RM: wrist centre and stylus axis in the device frame
-  const RmPose rm = rm_pose(q_dh, out);
+  // 1. the RM: wrist centre and stylus axis in the device frame, and the
+  // arm's Jacobian for step 5, in one pass over the chain
+  const OmniArmKinematics arm = omni_arm_kinematics(params_.omni, q_dh);
+  const RmPose rm = rm_pose(arm, out);
   // 2. theta_R: the VM aligned with the stylus (kept where undefined)
   if (!vm_->aligned(rm, &theta_r_)) st |= kStatusOrientationDegenerate;
   // 3-4. placement, error and projected force
@@ -387,7 +405,7 @@ ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept 
     reset();
     return out->status;
   }
-  st |= saturate_and_map(q_dh, out);
+  st |= saturate_and_map(arm.Jv_arm, out);
   out->status = st;
   return st;
 }
