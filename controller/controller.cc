@@ -233,7 +233,8 @@ ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
                                    ControlOutput* out) noexcept {
   ControlStatus st = place(rm, locked, out);
   const double u = params_.length_unit_mm;
-  const VmPose vm_pose = vm_->pose(theta_v_);
+  VmPose vm_pose;
+  vm_->pose_jacobian(theta_v_, &vm_pose, &J_);
   if (params_.placement == PlacementMethod::kClosedForm) {
     out->placement_cost = closed_form_cost(vm_pose, rm);
   }
@@ -260,7 +261,6 @@ ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
   }
   // eq. 3.8 with eq. 3.28's diagonal gains, then eq. 3.11
   const Vec6 g = kp_.cwiseProduct(out->e) + kv_.cwiseProduct(out->e_dot);
-  vm_->jacobian(theta_v_, &J_);
   active_columns(J_, locked, &J_active_);
   const ProjectionResult pr = project_motion_force(
       J_active_, params_.projection_weights, g, params_.singular_rcond,

@@ -17,6 +17,10 @@ constexpr double kDegenerateFraction = 1e-9;
 // |sin| below which an axis is treated as lying on a pole
 constexpr double kPoleSin = 1e-12;
 
+// hypot(x, y) > t for t > 0, without hypot's care for overflow: the
+// arguments here are lengths in mm or unit-vector components
+bool above(double x, double y, double t) { return x * x + y * y > t * t; }
+
 double clamp_unit(double x) { return x < -1.0 ? -1.0 : (x > 1.0 ? 1.0 : x); }
 
 void check_mount(const VmMount& mount, double length) {
@@ -198,30 +202,50 @@ Mat3 VirtualMechanism::orientation_error_jacobian(const VmPose& vm,
 CircleVm::CircleVm(const VmMount& mount, double length)
     : VirtualMechanism(mount, length) {}
 
+namespace {
+
+VmPose circle_pose(const VmMount& mount, double length, double c, double s) {
+  VmPose out;
+  out.axis = mount.R * Vec3(c, s, 0.0);
+  out.p = mount.origin + length * out.axis;
+  Mat3 Rz;
+  Rz << c, -s, 0, s, c, 0, 0, 0, 1;  // rot_z(theta) from the same c, s
+  out.R = mount.R * Rz;
+  return out;
+}
+
+void circle_jacobian(const VmMount& mount, double length, double c, double s,
+                     VmJacobian* J) {
+  J->resize(6, 1);
+  J->block<3, 1>(0, 0) = mount.R * Vec3(-length * s, length * c, 0.0);
+  J->block<3, 1>(3, 0) = mount.R.col(2);
+}
+
+}  // namespace
+
+void CircleVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
+                             VmJacobian* J) const {
+  const double c = std::cos(theta[0]), s = std::sin(theta[0]);
+  *pose = circle_pose(mount_, length_, c, s);
+  circle_jacobian(mount_, length_, c, s, J);
+}
+
 VmPose CircleVm::pose(const VmAngles& theta) const {
   // eq. 3.25/3.26 in the pivot frame, then into the device frame
   const double c = std::cos(theta[0]), s = std::sin(theta[0]);
-  VmPose out;
-  out.axis = mount_.R * Vec3(c, s, 0.0);
-  out.p = mount_.origin + length_ * out.axis;
-  out.R = mount_.R * rot_z(theta[0]);
-  return out;
+  return circle_pose(mount_, length_, c, s);
 }
 
 void CircleVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
   // eq. 3.27: (-L sin, L cos, 0, 0, 0, 1) in the pivot frame
   const double c = std::cos(theta[0]), s = std::sin(theta[0]);
-  J->resize(6, 1);
-  J->block<3, 1>(0, 0) = mount_.R * Vec3(-length_ * s, length_ * c, 0.0);
-  J->block<3, 1>(3, 0) = mount_.R.col(2);
+  circle_jacobian(mount_, length_, c, s, J);
 }
 
 bool CircleVm::nearest(const RmPose& rm, VmAngles* theta) const {
   // §3.3.1: theta_V = atan2(Y - Y0, X - X0), in the pivot frame
   const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
-  if (!(std::hypot(d.x(), d.y()) > kDegenerateFraction * length_)) {
-    return false;
-  }
+  if (!above(d.x(), d.y(), kDegenerateFraction * length_)) return false;
   (*theta)[0] = std::atan2(d.y(), d.x());
   return true;
 }
@@ -229,7 +253,7 @@ bool CircleVm::nearest(const RmPose& rm, VmAngles* theta) const {
 bool CircleVm::aligned(const RmPose& rm, VmAngles* theta) const {
   // §3.3.1: theta_R = atan2(Z_y, Z_x) of the stylus z axis
   const Vec3 a = mount_.R.transpose() * rm.axis;
-  if (!(std::hypot(a.x(), a.y()) > kPoleSin)) return false;
+  if (!above(a.x(), a.y(), kPoleSin)) return false;
   (*theta)[0] = std::atan2(a.y(), a.x());
   return true;
 }
@@ -269,27 +293,35 @@ void CircleVm::normalize(VmAngles* theta) const {
 SphereVm::SphereVm(const VmMount& mount, double length)
     : VirtualMechanism(mount, length) {}
 
-VmPose SphereVm::pose(const VmAngles& theta) const {
+namespace {
+
+struct SphereTrig {
+  double s1, c1, s2, c2;
+  explicit SphereTrig(const VmAngles& theta)
+      : s1(std::sin(theta[0])), c1(std::cos(theta[0])),
+        s2(std::sin(theta[1])), c2(std::cos(theta[1])) {}
+};
+
+VmPose sphere_pose(const VmMount& mount, double length, const SphereTrig& t,
+                   double theta3) {
   // eq. 3.29/3.30 in the pivot frame
-  const double s1 = std::sin(theta[0]), c1 = std::cos(theta[0]);
-  const double s2 = std::sin(theta[1]), c2 = std::cos(theta[1]);
-  const double s3 = std::sin(theta[2]), c3 = std::cos(theta[2]);
+  const double s1 = t.s1, c1 = t.c1, s2 = t.s2, c2 = t.c2;
+  const double s3 = std::sin(theta3), c3 = std::cos(theta3);
   Mat3 R;
   R << s1 * s3 + c1 * c2 * c3, s1 * c3 - c1 * c2 * s3, c1 * s2,  //
       s1 * c2 * c3 - c1 * s3, -c1 * c3 - s1 * c2 * s3, s1 * s2,  //
       s2 * c3, -s2 * s3, -c2;
   VmPose out;
-  out.R = mount_.R * R;
+  out.R = mount.R * R;
   out.axis = out.R.col(2);
-  out.p = mount_.origin + length_ * out.axis;
+  out.p = mount.origin + length * out.axis;
   return out;
 }
 
-void SphereVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
+void sphere_jacobian(const VmMount& mount, double L, const SphereTrig& t,
+                     VmJacobian* J) {
   // eq. 3.31 in the pivot frame
-  const double s1 = std::sin(theta[0]), c1 = std::cos(theta[0]);
-  const double s2 = std::sin(theta[1]), c2 = std::cos(theta[1]);
-  const double L = length_;
+  const double s1 = t.s1, c1 = t.c1, s2 = t.s2, c2 = t.c2;
   Eigen::Matrix<double, 6, 3> Jl;
   Jl << -L * s1 * s2, L * c1 * c2, 0,  //
       L * c1 * s2, L * s1 * c2, 0,     //
@@ -298,8 +330,25 @@ void SphereVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
       0, -c1, s1 * s2,                 //
       1, 0, -c2;
   J->resize(6, 3);
-  J->topRows<3>() = mount_.R * Jl.topRows<3>();
-  J->bottomRows<3>() = mount_.R * Jl.bottomRows<3>();
+  J->topRows<3>() = mount.R * Jl.topRows<3>();
+  J->bottomRows<3>() = mount.R * Jl.bottomRows<3>();
+}
+
+}  // namespace
+
+VmPose SphereVm::pose(const VmAngles& theta) const {
+  return sphere_pose(mount_, length_, SphereTrig(theta), theta[2]);
+}
+
+void SphereVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
+  sphere_jacobian(mount_, length_, SphereTrig(theta), J);
+}
+
+void SphereVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
+                             VmJacobian* J) const {
+  const SphereTrig t(theta);
+  *pose = sphere_pose(mount_, length_, t, theta[2]);
+  sphere_jacobian(mount_, length_, t, J);
 }
 
 namespace {
@@ -308,7 +357,7 @@ namespace {
 // on the pole axis theta1 is left as it was
 void sphere_angles(const Vec3& d, VmAngles* theta) {
   (*theta)[1] = std::acos(clamp_unit(-d.z()));
-  if (std::hypot(d.x(), d.y()) > kPoleSin) {
+  if (above(d.x(), d.y(), kPoleSin)) {
     (*theta)[0] = std::atan2(d.y(), d.x());
   }
 }
