@@ -182,6 +182,25 @@ ProjectionResult project_motion_force(const VmJacobian& J, const Vec6& W_A,
     // tridiagonalises in closed form instead of by Householder reflections
     const Eigen::Matrix<double, 6, 3> J3 = J;
     const Mat3 A = J3.transpose() * WA * J3;
+    // the eigenvalues alone in closed form give rcond; where the damping
+    // changes no 1/s by more than 1e-16 relative (rho <= 1e-8 s_min, so
+    // (rho/s)^2 <= 1e-16), the regularised inverse is A^-1 to rounding and
+    // a Cholesky solve gives it; elsewhere the eigenvectors are needed
+    Eigen::SelfAdjointEigenSolver<Mat3> values;
+    values.computeDirect(A, Eigen::EigenvaluesOnly);
+    const Vec3& sv = values.eigenvalues();  // ascending
+    const double sv_max = std::max(sv[2], 0.0);
+    const double sv_min = std::max(sv[0], 0.0);
+    if (sv_max > 0.0 && damping * sv_max <= 1e-8 * sv_min) {
+      const Eigen::LLT<Mat3> llt(A);
+      if (llt.info() == Eigen::Success) {
+        result.rcond = sv_min / sv_max;
+        result.singular = !(result.rcond >= singular_rcond);
+        const Vec3 z = llt.solve(J3.transpose() * g);
+        *f = g - WA * (J3 * z);
+        return result;
+      }
+    }
     Eigen::SelfAdjointEigenSolver<Mat3> eig(A);
     const Vec3& s = eig.eigenvalues();  // ascending
     const double s_max = std::max(s[2], 0.0);

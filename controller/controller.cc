@@ -239,7 +239,7 @@ ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
     out->placement_cost = closed_form_cost(vm_pose, rm);
   }
   out->x_v_mm = vm_pose.p * u;
-  out->x_r_mm = vm_->pose(theta_r_).p * u;
+  out->x_r_mm = vm_->position(theta_r_) * u;
   // eq. 3.9: e = X_V - X_R
   out->e.head<3>() = vm_pose.p - rm.p;
   if (params_.error == ErrorFormulation::kThesis) {

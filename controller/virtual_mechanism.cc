@@ -230,6 +230,11 @@ void CircleVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
   circle_jacobian(mount_, length_, c, s, J);
 }
 
+Vec3 CircleVm::position(const VmAngles& theta) const {
+  const double c = std::cos(theta[0]), s = std::sin(theta[0]);
+  return mount_.origin + length_ * (mount_.R * Vec3(c, s, 0.0));
+}
+
 VmPose CircleVm::pose(const VmAngles& theta) const {
   // eq. 3.25/3.26 in the pivot frame, then into the device frame
   const double c = std::cos(theta[0]), s = std::sin(theta[0]);
@@ -335,6 +340,13 @@ void sphere_jacobian(const VmMount& mount, double L, const SphereTrig& t,
 }
 
 }  // namespace
+
+Vec3 SphereVm::position(const VmAngles& theta) const {
+  // the link axis, column 3 of eq. 3.29's rotation: no twist needed
+  const SphereTrig t(theta);
+  return mount_.origin +
+         length_ * (mount_.R * Vec3(t.c1 * t.s2, t.s1 * t.s2, -t.c2));
+}
 
 VmPose SphereVm::pose(const VmAngles& theta) const {
   return sphere_pose(mount_, length_, SphereTrig(theta), theta[2]);

@@ -101,6 +101,11 @@ class VirtualMechanism {
   // unit per rad, or per length unit for a prismatic joint), rows 3-5 angular
   // velocity (rad per rad); device frame
   virtual void jacobian(const VmAngles& theta, VmJacobian* J) const = 0;
+  // X_V(theta)'s position alone (pose(theta).p), for a VM that can skip
+  // the rest
+  virtual Vec3 position(const VmAngles& theta) const {
+    return pose(theta).p;
+  }
   // both at one theta (what a servo tick needs), sharing their sines and
   // cosines where a VM overrides it; the same numbers as pose() and
   // jacobian()
@@ -193,6 +198,7 @@ class CircleVm final : public VirtualMechanism {
   void jacobian(const VmAngles& theta, VmJacobian* J) const override;
   void pose_jacobian(const VmAngles& theta, VmPose* pose,
                      VmJacobian* J) const override;
+  Vec3 position(const VmAngles& theta) const override;
   bool nearest(const RmPose& rm, VmAngles* theta) const override;
   bool aligned(const RmPose& rm, VmAngles* theta) const override;
   Vec3 thesis_orientation_error(const VmAngles& theta_v,
@@ -216,6 +222,7 @@ class SphereVm final : public VirtualMechanism {
   void jacobian(const VmAngles& theta, VmJacobian* J) const override;
   void pose_jacobian(const VmAngles& theta, VmPose* pose,
                      VmJacobian* J) const override;
+  Vec3 position(const VmAngles& theta) const override;
   bool nearest(const RmPose& rm, VmAngles* theta) const override;
   bool aligned(const RmPose& rm, VmAngles* theta) const override;
   Vec3 thesis_orientation_error(const VmAngles& theta_v,
