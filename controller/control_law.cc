@@ -45,6 +45,23 @@ namespace {
 double weighted_cost(const Vec6& r, const Vec6& w) {
   return r.dot(w.cwiseProduct(r));
 }
+
+bool weighs_orientation(const Vec6& w) {
+  return (w.tail<3>().array() != 0.0).any();
+}
+
+// placement_residual with the orientation rows left at zero where W does not
+// weigh them: they would add exactly 0 to r^T W r and to J^T W r (the
+// geometric error is finite for finite input), and their atan2 is most of a
+// residual's cost under W_p
+Vec6 weighted_residual(const VirtualMechanism& vm, const RmPose& rm,
+                       const VmAngles& theta, bool orientation) {
+  if (orientation) return placement_residual(vm, rm, theta);
+  Vec6 r;
+  r.head<3>() = rm.p - vm.position(theta);
+  r.tail<3>().setZero();
+  return r;
+}
 }  // namespace
 
 PlacementResult place_gauss_newton(const VirtualMechanism& vm,
@@ -63,7 +80,8 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
   VmJacobian J, Ja;
   SmallSquare A, A_damped;
   VmAngles grad, step, full_step, trial, scale;
-  Vec6 r = placement_residual(vm, rm, *theta);
+  const bool orientation = weighs_orientation(w);
+  Vec6 r = weighted_residual(vm, rm, *theta, orientation);
   double cost = weighted_cost(r, w);
   double mu = options.relative_damping;  // relative to diag(A)
   double nu = 2.0;
@@ -73,9 +91,16 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
       // the residual's Jacobian: -J_V with the angular rows carried through
       // the derivative of the rotation-vector error, which differs from the
       // identity once the axes are far apart
-      vm.jacobian(*theta, &J);
-      const Mat3 M = vm.orientation_error_jacobian(vm.pose(*theta), rm);
-      J.bottomRows<3>() = (M * J.bottomRows<3>()).eval();
+      // (under W_p the angular rows meet only zero weights and zero
+      // residual rows, so M is not needed there)
+      if (orientation) {
+        VmPose pose;
+        vm.pose_jacobian(*theta, &pose, &J);
+        const Mat3 M = vm.orientation_error_jacobian(pose, rm);
+        J.bottomRows<3>() = (M * J.bottomRows<3>()).eval();
+      } else {
+        vm.jacobian(*theta, &J);
+      }
       active_columns(J, locked, &Ja);
       if (Ja.cols() == 0) {
         result.converged = true;
@@ -111,7 +136,7 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
     }
     trial = *theta + full_step;
     vm.normalize(&trial);
-    const Vec6 r_trial = placement_residual(vm, rm, trial);
+    const Vec6 r_trial = weighted_residual(vm, rm, trial, orientation);
     const double cost_trial = weighted_cost(r_trial, w);
     // predicted decrease of r^T W r for the linearised residual
     const double predicted = step.dot(2.0 * grad - A * step);

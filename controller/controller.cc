@@ -214,11 +214,21 @@ ControlStatus Controller::place(const RmPose& rm, JointMask locked,
     // start can sit on the wrong side of a circle after a fast move, and
     // for W_p the closed form is already the answer
     const Vec6& w = params_.placement_options.weights;
-    const Vec6 r_warm = placement_residual(*vm_, rm, theta_v_);
-    const Vec6 r_seed = placement_residual(*vm_, rm, seed_);
-    if (r_seed.dot(w.cwiseProduct(r_seed)) <
-        r_warm.dot(w.cwiseProduct(r_warm))) {
-      theta_v_ = seed_;
+    if ((w.tail<3>().array() != 0.0).any()) {
+      const Vec6 r_warm = placement_residual(*vm_, rm, theta_v_);
+      const Vec6 r_seed = placement_residual(*vm_, rm, seed_);
+      if (r_seed.dot(w.cwiseProduct(r_seed)) <
+          r_warm.dot(w.cwiseProduct(r_warm))) {
+        theta_v_ = seed_;
+      }
+    } else {
+      // the orientation rows would add exactly 0: positions only
+      const Vec3 r_warm = rm.p - vm_->position(theta_v_);
+      const Vec3 r_seed = rm.p - vm_->position(seed_);
+      if (r_seed.dot(w.head<3>().cwiseProduct(r_seed)) <
+          r_warm.dot(w.head<3>().cwiseProduct(r_warm))) {
+        theta_v_ = seed_;
+      }
     }
   }
   const PlacementResult res = place_gauss_newton(
