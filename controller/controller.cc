@@ -264,7 +264,8 @@ ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
   if (have_previous_) {
     Vec6 d = out->e - e_previous_;
     for (int i = 3; i < 6; ++i) d[i] = wrap_angle(d[i]);
-    const Vec6 raw = d / params_.servo_period_s;
+    // one division instead of six
+    const Vec6 raw = d * (1.0 / params_.servo_period_s);
     out->e_dot = e_dot_filtered_ + velocity_alpha_ * (raw - e_dot_filtered_);
   } else {
     out->e_dot.setZero();
@@ -311,7 +312,7 @@ RmPose Controller::rm_pose(const OmniArmKinematics& arm,
   out->p_rm_mm = base_to_device_mm(omni, arm.p_base_m);
   out->axis_rm = base_to_device_vector(arm.z6_base);
   RmPose rm;
-  rm.p = out->p_rm_mm / params_.length_unit_mm;
+  rm.p = out->p_rm_mm * (1.0 / params_.length_unit_mm);
   rm.axis = out->axis_rm;
   return rm;
 }
@@ -351,9 +352,11 @@ ControlStatus Controller::saturate_and_map(const Mat3& Jv_arm,
   ControlStatus st = kStatusOk;
   const OmniParams& omni = params_.omni;
   Vec3 F = out->f_motion.head<3>();
-  const double F_norm = F.norm();
-  if (F_norm > params_.force_limit_N) {
-    F *= params_.force_limit_N / F_norm;
+  // |F| only when over the limit: the square root's latency sat on the
+  // tick's critical path in perf
+  const double F_limit = params_.force_limit_N;
+  if (F.squaredNorm() > F_limit * F_limit) {
+    F *= F_limit / F.norm();
     st |= kStatusForceSaturated;
   }
   // eq. 3.12 with the wrist-centre Jacobian's linear rows (m/rad) and the

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "controller/trig.h"
+
 namespace vmh {
 
 namespace {
@@ -45,6 +47,10 @@ void push_unique(const OmniParams& params, const Joints& q, IkSolutions* out) {
 double wrap_angle(double a) {
   // the common case costs two comparisons; NaN fails them and passes through
   if (a > -kPi && a <= kPi) return a;
+  // one turn off (a difference of two wrapped angles): subtracting 2 pi is
+  // exact there (Sterbenz) and is what remainder() returns, without its call
+  if (a > kPi && a < 2.5 * kPi) return a - 2.0 * kPi;
+  if (a <= -kPi && a > -2.5 * kPi) return a + 2.0 * kPi;
   if (!std::isfinite(a)) return a;
   // remainder() gives [-pi, pi]; move -pi to +pi for a half-open range
   double w = std::remainder(a, 2.0 * kPi);
@@ -150,10 +156,12 @@ struct ClosedChain {
 
 ClosedChain arm_chain(const OmniParams& params, const Joints& q) {
   ClosedChain k;
-  k.c1 = std::cos(q[0]);
-  k.s1 = std::sin(q[0]);
-  const double c2 = std::cos(q[1]), s2 = std::sin(q[1]);
-  const double c23 = std::cos(q[1] + q[2]), s23 = std::sin(q[1] + q[2]);
+  const SinCos t1 = sin_cos(q[0]), t2 = sin_cos(q[1]),
+               t23 = sin_cos(q[1] + q[2]);
+  k.c1 = t1.c;
+  k.s1 = t1.s;
+  const double c2 = t2.c, s2 = t2.s;
+  const double c23 = t23.c, s23 = t23.s;
   const double c1 = k.c1, s1 = k.s1;
   k.z2 = Vec3(s1, -c1, 0.0);
   k.x3 = Vec3(c1 * c23, s1 * c23, s23);
@@ -170,9 +178,10 @@ ClosedChain arm_chain(const OmniParams& params, const Joints& q) {
 void omni_fk_jacobian(const OmniParams& params, const Joints& q,
                       OmniPose* pose, Mat6* J, double offset_m) {
   const ClosedChain k = arm_chain(params, q);
-  const double c4 = std::cos(q[3]), s4 = std::sin(q[3]);
-  const double c5 = std::cos(q[4]), s5 = std::sin(q[4]);
-  const double c6 = std::cos(q[5]), s6 = std::sin(q[5]);
+  const SinCos t4 = sin_cos(q[3]), t5 = sin_cos(q[4]), t6 = sin_cos(q[5]);
+  const double c4 = t4.c, s4 = t4.s;
+  const double c5 = t5.c, s5 = t5.s;
+  const double c6 = t6.c, s6 = t6.s;
   const Vec3& z3 = k.z2;
   const Vec3 x4 = c4 * k.x3 + s4 * z3;
   const Vec3 y4 = -s4 * k.x3 + c4 * z3;
@@ -208,8 +217,9 @@ void omni_fk_jacobian(const OmniParams& params, const Joints& q,
 OmniArmKinematics omni_arm_kinematics(const OmniParams& params,
                                       const Joints& q) {
   const ClosedChain k = arm_chain(params, q);
-  const double c4 = std::cos(q[3]), s4 = std::sin(q[3]);
-  const double c5 = std::cos(q[4]), s5 = std::sin(q[4]);
+  const SinCos t4 = sin_cos(q[3]), t5 = sin_cos(q[4]);
+  const double c4 = t4.c, s4 = t4.s;
+  const double c5 = t5.c, s5 = t5.s;
   OmniArmKinematics out;
   out.p_base_m = k.p;
   // z6 = y5 = c5 x4 - s5 z4 with x4 = c4 x3 + s4 z3

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "controller/omni_kinematics.h"  // wrap_angle
+#include "controller/trig.h"
 
 namespace vmh {
 namespace {
@@ -49,7 +50,8 @@ Vec3 perpendicular(const Vec3& u) {
 // rotation about the local z axis
 Mat3 rot_z(double a) {
   Mat3 R;
-  const double c = std::cos(a), s = std::sin(a);
+  const SinCos t = sin_cos(a);
+  const double c = t.c, s = t.s;
   R << c, -s, 0, s, c, 0, 0, 0, 1;
   return R;
 }
@@ -205,12 +207,15 @@ CircleVm::CircleVm(const VmMount& mount, double length)
 namespace {
 
 VmPose circle_pose(const VmMount& mount, double length, double c, double s) {
+  // R rot_z(theta) column by column: rot_z mixes only the first two
+  // columns, and the link axis R (c, s, 0) is the first of them, so neither
+  // needs a 3 x 3 product
   VmPose out;
-  out.axis = mount.R * Vec3(c, s, 0.0);
+  out.R.col(0) = c * mount.R.col(0) + s * mount.R.col(1);
+  out.R.col(1) = c * mount.R.col(1) - s * mount.R.col(0);
+  out.R.col(2) = mount.R.col(2);
+  out.axis = out.R.col(0);
   out.p = mount.origin + length * out.axis;
-  Mat3 Rz;
-  Rz << c, -s, 0, s, c, 0, 0, 0, 1;  // rot_z(theta) from the same c, s
-  out.R = mount.R * Rz;
   return out;
 }
 
@@ -225,25 +230,29 @@ void circle_jacobian(const VmMount& mount, double length, double c, double s,
 
 void CircleVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
                              VmJacobian* J) const {
-  const double c = std::cos(theta[0]), s = std::sin(theta[0]);
+  const SinCos t = sin_cos(theta[0]);
+  const double c = t.c, s = t.s;
   *pose = circle_pose(mount_, length_, c, s);
   circle_jacobian(mount_, length_, c, s, J);
 }
 
 Vec3 CircleVm::position(const VmAngles& theta) const {
-  const double c = std::cos(theta[0]), s = std::sin(theta[0]);
+  const SinCos t = sin_cos(theta[0]);
+  const double c = t.c, s = t.s;
   return mount_.origin + length_ * (mount_.R * Vec3(c, s, 0.0));
 }
 
 VmPose CircleVm::pose(const VmAngles& theta) const {
   // eq. 3.25/3.26 in the pivot frame, then into the device frame
-  const double c = std::cos(theta[0]), s = std::sin(theta[0]);
+  const SinCos t = sin_cos(theta[0]);
+  const double c = t.c, s = t.s;
   return circle_pose(mount_, length_, c, s);
 }
 
 void CircleVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
   // eq. 3.27: (-L sin, L cos, 0, 0, 0, 1) in the pivot frame
-  const double c = std::cos(theta[0]), s = std::sin(theta[0]);
+  const SinCos t = sin_cos(theta[0]);
+  const double c = t.c, s = t.s;
   circle_jacobian(mount_, length_, c, s, J);
 }
 
@@ -303,15 +312,16 @@ namespace {
 struct SphereTrig {
   double s1, c1, s2, c2;
   explicit SphereTrig(const VmAngles& theta)
-      : s1(std::sin(theta[0])), c1(std::cos(theta[0])),
-        s2(std::sin(theta[1])), c2(std::cos(theta[1])) {}
+      : SphereTrig(sin_cos(theta[0]), sin_cos(theta[1])) {}
+  SphereTrig(SinCos t1, SinCos t2) : s1(t1.s), c1(t1.c), s2(t2.s), c2(t2.c) {}
 };
 
 VmPose sphere_pose(const VmMount& mount, double length, const SphereTrig& t,
                    double theta3) {
   // eq. 3.29/3.30 in the pivot frame
   const double s1 = t.s1, c1 = t.c1, s2 = t.s2, c2 = t.c2;
-  const double s3 = std::sin(theta3), c3 = std::cos(theta3);
+  const SinCos t3 = sin_cos(theta3);
+  const double s3 = t3.s, c3 = t3.c;
   Mat3 R;
   R << s1 * s3 + c1 * c2 * c3, s1 * c3 - c1 * c2 * s3, c1 * s2,  //
       s1 * c2 * c3 - c1 * s3, -c1 * c3 - s1 * c2 * s3, s1 * s2,  //
@@ -426,8 +436,9 @@ VmPose SurfaceVm::pose(const VmAngles& theta) const {
   // frame = Rx(alpha) Rz(beta) C Rz(gamma) in the plane frame, with C the
   // constant rotation taking (x, y, z) to (y, z, x); its z column is
   // u = (cos b, sin b cos a, sin b sin a)
-  const double sa = std::sin(theta[2]), ca = std::cos(theta[2]);
-  const double sb = std::sin(theta[3]), cb = std::cos(theta[3]);
+  const SinCos ta = sin_cos(theta[2]), tb = sin_cos(theta[3]);
+  const double sa = ta.s, ca = ta.c;
+  const double sb = tb.s, cb = tb.c;
   Mat3 F;
   F.col(0) = Vec3(-sb, cb * ca, cb * sa);  // du/dbeta
   F.col(2) = Vec3(cb, sb * ca, sb * sa);   // u
@@ -440,8 +451,9 @@ VmPose SurfaceVm::pose(const VmAngles& theta) const {
 }
 
 void SurfaceVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
-  const double sa = std::sin(theta[2]), ca = std::cos(theta[2]);
-  const double sb = std::sin(theta[3]), cb = std::cos(theta[3]);
+  const SinCos ta = sin_cos(theta[2]), tb = sin_cos(theta[3]);
+  const double sa = ta.s, ca = ta.c;
+  const double sb = tb.s, cb = tb.c;
   const Vec3 t1 = mount_.R.col(0);
   const Vec3 u = mount_.R * Vec3(cb, sb * ca, sb * sa);
   const Vec3 w_beta = mount_.R * Vec3(0.0, -sa, ca);
