@@ -71,8 +71,10 @@ Mat6 omni_jacobian_at(const OmniParams& params, const Joints& q_dh,
 // Table B.1's products (derived in docs/kinematics.md), with the sines and
 // cosines of q1..q6 computed once and shared, and no 4 x 4 products. Equal to
 // omni_fk and omni_jacobian_at (which compose the chain, omni_frames) within
-// 1e-12 (tests/controller/omni_kinematics_test.cc). *J (optional) is the
-// geometric Jacobian at the point offset_m along z6, as omni_jacobian_at.
+// 1e-12 (tests/controller/omni_kinematics_one_pass_test.cc). *J (optional)
+// is the geometric Jacobian at the point offset_m along z6, as
+// omni_jacobian_at. The sines and cosines come from sin_cos
+// (controller/trig.h).
 void omni_fk_jacobian(const OmniParams& params, const Joints& q_dh,
                       OmniPose* pose, Mat6* J, double offset_m = 0.0);
 
