@@ -25,6 +25,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -87,6 +88,34 @@ void over_samples(benchmark::State& state, F f) {
   bench::over_samples(state, samples(), f);
 }
 
+// A closed, smooth path through the joint ranges, one configuration per
+// servo period (1 ms): each joint swings about the middle of its range by
+// 30% of the range, a whole number of times per 1024 samples, so the cycle
+// closes without a jump. Consecutive configurations are 1 ms apart, as in a
+// servo loop, so the controller's warm start is what it would be on the
+// device (the joints move at up to about 4 rad/s).
+const std::vector<Joints>& trajectory() {
+  static const std::vector<Joints> set = [] {
+    const OmniParams params;
+    constexpr double kTwoPi = 6.283185307179586;
+    const int turns[kOmniJoints] = {1, 1, 2, 1, 2, 1};
+    const double phase[kOmniJoints] = {0.0, 1.0, 2.0, 0.5, 1.5, 2.5};
+    std::vector<Joints> out(kSamples);
+    for (std::size_t k = 0; k < kSamples; ++k) {
+      for (int i = 0; i < kOmniJoints; ++i) {
+        const auto j = static_cast<std::size_t>(i);
+        const double lo = params.joint_lower_rad[j];
+        const double hi = params.joint_upper_rad[j];
+        const double t = static_cast<double>(k) / static_cast<double>(kSamples);
+        out[k][i] = 0.5 * (lo + hi) +
+                    0.3 * (hi - lo) * std::sin(kTwoPi * turns[i] * t + phase[i]);
+      }
+    }
+    return out;
+  }();
+  return set;
+}
+
 ControllerParams make_params(VmKind kind, PlacementMethod placement,
                              ErrorFormulation error) {
   ControllerParams p;
@@ -114,6 +143,93 @@ void BM_controller_tick(benchmark::State& state, VmKind kind,
   ControlOutput out;
   over_samples(state, [&](const Sample& s) {
     ControlStatus st = controller.tick(s.q, &out);
+    benchmark::DoNotOptimize(st);
+    benchmark::DoNotOptimize(out);
+  });
+}
+
+// A closed path along which the stylus follows the VM, as it does while the
+// user holds it against the VM (the servo's real use): the wrist centre
+// circles once per 1024 samples (1 ms each) on the VM's path in the device
+// frame, pressed 2 mm past it (the circle and the sphere of radius L about
+// the origin, the surface's handle plane at L above it) with a 1 mm wobble,
+// and the gimbal swings by up to 0.3 rad about zero, where the stylus axis
+// is the device z axis (the surface's normal). q1..q3 come from the IK
+// (nearest the previous sample), outside any timed region.
+const std::vector<Joints>& on_path(VmKind kind) {
+  static std::vector<Joints> sets[3];
+  std::vector<Joints>& set = sets[static_cast<int>(kind)];
+  if (!set.empty()) return set;
+  const OmniParams params;
+  constexpr double kTwoPi = 6.283185307179586;
+  set.resize(kSamples);
+  Joints near = Joints::Zero();
+  for (std::size_t k = 0; k < kSamples; ++k) {
+    const double a = kTwoPi * static_cast<double>(k) / kSamples;
+    const double wobble_mm = std::sin(7.0 * a);
+    Vec3 p_mm;
+    switch (kind) {
+      case VmKind::kCircle: {
+        const double r = kLength_mm + 2.0 + wobble_mm;
+        p_mm = Vec3(r * std::cos(a), r * std::sin(a), wobble_mm);
+        break;
+      }
+      case VmKind::kSphere: {
+        // a tilted great-circle-like loop on the sphere, in front of the
+        // pivot (toward the user)
+        const double r = kLength_mm - 2.0 + wobble_mm;
+        const Vec3 d(0.6 * std::cos(a), 0.6 * std::sin(a), 0.8);
+        p_mm = r * d;
+        break;
+      }
+      case VmKind::kSurface: {
+        p_mm = Vec3(30.0 * std::cos(a), 30.0 * std::sin(a),
+                    kLength_mm - 2.0 + wobble_mm);
+        break;
+      }
+    }
+    const IkSolutions ik =
+        omni_ik_position(params, device_mm_to_base(params, p_mm), near);
+    const int best = omni_ik_nearest(ik, near);
+    if (best < 0) {
+      std::fprintf(stderr, "controller_bench: on_path sample %zu unreachable\n",
+                   k);
+      std::abort();
+    }
+    Joints q = ik.q_dh[static_cast<std::size_t>(best)];
+    q[3] = 0.3 * std::sin(2.0 * a);
+    q[4] = 0.2 * std::sin(3.0 * a + 1.0);
+    q[5] = 0.3 * std::sin(a + 2.0);
+    set[k] = q;
+    near = q;
+  }
+  return set;
+}
+
+// the same tick along trajectory(): the warm start of a servo loop
+void BM_controller_tick_trajectory(benchmark::State& state, VmKind kind,
+                                   PlacementMethod placement,
+                                   ErrorFormulation error) {
+  Controller controller(make_params(kind, placement, error));
+  ControlOutput out;
+  bench::over_samples(state, trajectory(), [&](const Joints& q) {
+    ControlStatus st = controller.tick(q, &out);
+    benchmark::DoNotOptimize(st);
+    benchmark::DoNotOptimize(out);
+  });
+}
+
+// the same tick along on_path(kind): the stylus following the VM
+void BM_controller_tick_on_path(benchmark::State& state, VmKind kind,
+                                PlacementMethod placement,
+                                ErrorFormulation error) {
+  Controller controller(make_params(kind, placement, error));
+  ControlOutput out;
+  const std::vector<Joints>& path = on_path(kind);
+  // one lap first, so that the timed laps start warm
+  for (const Joints& q : path) controller.tick(q, &out);
+  bench::over_samples(state, path, [&](const Joints& q) {
+    ControlStatus st = controller.tick(q, &out);
     benchmark::DoNotOptimize(st);
     benchmark::DoNotOptimize(out);
   });
@@ -185,6 +301,21 @@ void register_benchmarks() {
   }
   for (PlacementMethod placement : placements) {
     add_tick(VmKind::kSphere, placement, ErrorFormulation::kGeometric);
+  }
+  // along a smooth path, warm-started as in a servo loop
+  for (VmKind kind : kinds) {
+    for (PlacementMethod placement : placements) {
+      const std::string name = std::string("controller_tick_trajectory/") +
+                               vm_kind_name(kind) + "/" +
+                               placement_method_name(placement) + "/thesis";
+      benchmark::RegisterBenchmark(name.c_str(), BM_controller_tick_trajectory,
+                                   kind, placement, ErrorFormulation::kThesis);
+      const std::string on = std::string("controller_tick_on_path/") +
+                             vm_kind_name(kind) + "/" +
+                             placement_method_name(placement) + "/thesis";
+      benchmark::RegisterBenchmark(on.c_str(), BM_controller_tick_on_path,
+                                   kind, placement, ErrorFormulation::kThesis);
+    }
   }
   benchmark::RegisterBenchmark("appendix_d_tick/circle", BM_appendix_d_tick,
                                appendix_d::Mechanism::kCircle);

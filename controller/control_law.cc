@@ -45,6 +45,23 @@ namespace {
 double weighted_cost(const Vec6& r, const Vec6& w) {
   return r.dot(w.cwiseProduct(r));
 }
+
+bool weighs_orientation(const Vec6& w) {
+  return (w.tail<3>().array() != 0.0).any();
+}
+
+// placement_residual with the orientation rows left at zero where W does not
+// weigh them: they would add exactly 0 to r^T W r and to J^T W r (the
+// geometric error is finite for finite input), and their atan2 is most of a
+// residual's cost under W_p
+Vec6 weighted_residual(const VirtualMechanism& vm, const RmPose& rm,
+                       const VmAngles& theta, bool orientation) {
+  if (orientation) return placement_residual(vm, rm, theta);
+  Vec6 r;
+  r.head<3>() = rm.p - vm.position(theta);
+  r.tail<3>().setZero();
+  return r;
+}
 }  // namespace
 
 PlacementResult place_gauss_newton(const VirtualMechanism& vm,
@@ -63,7 +80,8 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
   VmJacobian J, Ja;
   SmallSquare A, A_damped;
   VmAngles grad, step, full_step, trial, scale;
-  Vec6 r = placement_residual(vm, rm, *theta);
+  const bool orientation = weighs_orientation(w);
+  Vec6 r = weighted_residual(vm, rm, *theta, orientation);
   double cost = weighted_cost(r, w);
   double mu = options.relative_damping;  // relative to diag(A)
   double nu = 2.0;
@@ -73,9 +91,16 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
       // the residual's Jacobian: -J_V with the angular rows carried through
       // the derivative of the rotation-vector error, which differs from the
       // identity once the axes are far apart
-      vm.jacobian(*theta, &J);
-      const Mat3 M = vm.orientation_error_jacobian(vm.pose(*theta), rm);
-      J.bottomRows<3>() = (M * J.bottomRows<3>()).eval();
+      // (under W_p the angular rows meet only zero weights and zero
+      // residual rows, so M is not needed there)
+      if (orientation) {
+        VmPose pose;
+        vm.pose_jacobian(*theta, &pose, &J);
+        const Mat3 M = vm.orientation_error_jacobian(pose, rm);
+        J.bottomRows<3>() = (M * J.bottomRows<3>()).eval();
+      } else {
+        vm.jacobian(*theta, &J);
+      }
       active_columns(J, locked, &Ja);
       if (Ja.cols() == 0) {
         result.converged = true;
@@ -111,7 +136,7 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
     }
     trial = *theta + full_step;
     vm.normalize(&trial);
-    const Vec6 r_trial = placement_residual(vm, rm, trial);
+    const Vec6 r_trial = weighted_residual(vm, rm, trial, orientation);
     const double cost_trial = weighted_cost(r_trial, w);
     // predicted decrease of r^T W r for the linearised residual
     const double predicted = step.dot(2.0 * grad - A * step);
@@ -163,6 +188,63 @@ ProjectionResult project_motion_force(const VmJacobian& J, const Vec6& W_A,
     return result;
   }
   const auto WA = W_A.asDiagonal();
+  if (m == 1 && projector == nullptr) {
+    // the circle: J^T W_A J is a scalar, its own eigenvalue with
+    // eigenvector 1; the same regularised inverse without the solver
+    const auto j = J.col(0);
+    const double s = j.dot(W_A.cwiseProduct(j));
+    const double s_max = std::max(s, 0.0);
+    result.rcond = s_max > 0.0 ? 1.0 : 0.0;
+    result.singular = !(result.rcond >= singular_rcond);
+    const double rho = damping * s_max;
+    const double den = s_max * s_max + rho * rho;
+    const double inv_s = den > 0.0 ? s_max / den : 0.0;
+    *f = g - W_A.cwiseProduct(j) * (inv_s * j.dot(g));
+    return result;
+  }
+  if (m == 3 && projector == nullptr) {
+    // the sphere: the same steps on fixed-size 3 x 3 matrices, which Eigen
+    // tridiagonalises in closed form instead of by Householder reflections
+    const Eigen::Matrix<double, 6, 3> J3 = J;
+    const Mat3 A = J3.transpose() * WA * J3;
+    // the eigenvalues alone in closed form give rcond; where the damping
+    // changes no 1/s by more than 1e-16 relative (rho <= 1e-8 s_min, so
+    // (rho/s)^2 <= 1e-16), the regularised inverse is A^-1 to rounding and
+    // a Cholesky solve gives it; elsewhere the eigenvectors are needed
+    Eigen::SelfAdjointEigenSolver<Mat3> values;
+    values.computeDirect(A, Eigen::EigenvaluesOnly);
+    const Vec3& sv = values.eigenvalues();  // ascending
+    const double sv_max = std::max(sv[2], 0.0);
+    const double sv_min = std::max(sv[0], 0.0);
+    if (sv_max > 0.0 && damping * sv_max <= 1e-8 * sv_min) {
+      const Eigen::LLT<Mat3> llt(A);
+      if (llt.info() == Eigen::Success) {
+        result.rcond = sv_min / sv_max;
+        result.singular = !(result.rcond >= singular_rcond);
+        const Vec3 z = llt.solve(J3.transpose() * g);
+        *f = g - WA * (J3 * z);
+        return result;
+      }
+    }
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(A);
+    const Vec3& s = eig.eigenvalues();  // ascending
+    const double s_max = std::max(s[2], 0.0);
+    const double s_min = std::max(s[0], 0.0);
+    result.rcond = s_max > 0.0 ? s_min / s_max : 0.0;
+    result.singular = !(result.rcond >= singular_rcond);
+    const double rho = damping * s_max;
+    Vec3 inv_s;
+    for (int i = 0; i < 3; ++i) {
+      const double si = std::max(s[i], 0.0);
+      const double den = si * si + rho * rho;
+      inv_s[i] = den > 0.0 ? si / den : 0.0;
+    }
+    const Vec3 x = J3.transpose() * g;
+    const Vec3 y = (eig.eigenvectors().transpose() * x).cwiseProduct(inv_s);
+    const Vec3 z = eig.eigenvectors() * y;
+    *f = g - WA * (J3 * z);
+    return result;
+  }
   SmallSquare A;
   A.noalias() = J.transpose() * WA * J;
   // A is symmetric positive semi-definite and at most 5 x 5

@@ -205,9 +205,8 @@ ControlStatus Controller::place(const RmPose& rm, JointMask locked,
   if (params_.placement == PlacementMethod::kClosedForm) {
     if (seed_ok) theta_v_ = seed_;
     out->placement_iterations = 0;
-    const Vec6 r = placement_residual(*vm_, rm, theta_v_);
-    out->placement_cost =
-        r.dot(params_.placement_options.weights.cwiseProduct(r));
+    // r^T W r at theta_V: evaluate() computes it from the pose it needs
+    // anyway (closed_form_cost)
     return st;
   }
   if (seed_ok) {
@@ -215,11 +214,21 @@ ControlStatus Controller::place(const RmPose& rm, JointMask locked,
     // start can sit on the wrong side of a circle after a fast move, and
     // for W_p the closed form is already the answer
     const Vec6& w = params_.placement_options.weights;
-    const Vec6 r_warm = placement_residual(*vm_, rm, theta_v_);
-    const Vec6 r_seed = placement_residual(*vm_, rm, seed_);
-    if (r_seed.dot(w.cwiseProduct(r_seed)) <
-        r_warm.dot(w.cwiseProduct(r_warm))) {
-      theta_v_ = seed_;
+    if ((w.tail<3>().array() != 0.0).any()) {
+      const Vec6 r_warm = placement_residual(*vm_, rm, theta_v_);
+      const Vec6 r_seed = placement_residual(*vm_, rm, seed_);
+      if (r_seed.dot(w.cwiseProduct(r_seed)) <
+          r_warm.dot(w.cwiseProduct(r_warm))) {
+        theta_v_ = seed_;
+      }
+    } else {
+      // the orientation rows would add exactly 0: positions only
+      const Vec3 r_warm = rm.p - vm_->position(theta_v_);
+      const Vec3 r_seed = rm.p - vm_->position(seed_);
+      if (r_seed.dot(w.head<3>().cwiseProduct(r_seed)) <
+          r_warm.dot(w.head<3>().cwiseProduct(r_warm))) {
+        theta_v_ = seed_;
+      }
     }
   }
   const PlacementResult res = place_gauss_newton(
@@ -234,9 +243,13 @@ ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
                                    ControlOutput* out) noexcept {
   ControlStatus st = place(rm, locked, out);
   const double u = params_.length_unit_mm;
-  const VmPose vm_pose = vm_->pose(theta_v_);
+  VmPose vm_pose;
+  vm_->pose_jacobian(theta_v_, &vm_pose, &J_);
+  if (params_.placement == PlacementMethod::kClosedForm) {
+    out->placement_cost = closed_form_cost(vm_pose, rm);
+  }
   out->x_v_mm = vm_pose.p * u;
-  out->x_r_mm = vm_->pose(theta_r_).p * u;
+  out->x_r_mm = vm_->position(theta_r_) * u;
   // eq. 3.9: e = X_V - X_R
   out->e.head<3>() = vm_pose.p - rm.p;
   if (params_.error == ErrorFormulation::kThesis) {
@@ -251,14 +264,14 @@ ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
   if (have_previous_) {
     Vec6 d = out->e - e_previous_;
     for (int i = 3; i < 6; ++i) d[i] = wrap_angle(d[i]);
-    const Vec6 raw = d / params_.servo_period_s;
+    // one division instead of six
+    const Vec6 raw = d * (1.0 / params_.servo_period_s);
     out->e_dot = e_dot_filtered_ + velocity_alpha_ * (raw - e_dot_filtered_);
   } else {
     out->e_dot.setZero();
   }
   // eq. 3.8 with eq. 3.28's diagonal gains, then eq. 3.11
   const Vec6 g = kp_.cwiseProduct(out->e) + kv_.cwiseProduct(out->e_dot);
-  vm_->jacobian(theta_v_, &J_);
   active_columns(J_, locked, &J_active_);
   const ProjectionResult pr = project_motion_force(
       J_active_, params_.projection_weights, g, params_.singular_rcond,
@@ -278,13 +291,28 @@ ControlStatus Controller::fail_input(ControlOutput* out) noexcept {
   return out->status;
 }
 
-RmPose Controller::rm_pose(const Joints& q_dh, ControlOutput* out) const noexcept {
+double Controller::closed_form_cost(const VmPose& vm_pose,
+                                    const RmPose& rm) const noexcept {
+  // placement_residual's r^T W r at theta_V, from the pose already computed;
+  // the orientation rows (an atan2) only where W weighs them, as they would
+  // add exactly 0 otherwise
+  const Vec6& w = params_.placement_options.weights;
+  const Vec3 r_p = rm.p - vm_pose.p;
+  double cost = r_p.dot(w.head<3>().cwiseProduct(r_p));
+  if ((w.tail<3>().array() != 0.0).any()) {
+    const Vec3 r_o = -vm_->geometric_orientation_error(vm_pose, rm, nullptr);
+    cost += r_o.dot(w.tail<3>().cwiseProduct(r_o));
+  }
+  return cost;
+}
+
+RmPose Controller::rm_pose(const OmniArmKinematics& arm,
+                           ControlOutput* out) const noexcept {
   const OmniParams& omni = params_.omni;
-  const OmniPose pose = omni_fk(omni, q_dh);
-  out->p_rm_mm = base_to_device_mm(omni, pose.p_base_m);
-  out->axis_rm = base_to_device_vector(pose.R_base.col(2));
+  out->p_rm_mm = base_to_device_mm(omni, arm.p_base_m);
+  out->axis_rm = base_to_device_vector(arm.z6_base);
   RmPose rm;
-  rm.p = out->p_rm_mm / params_.length_unit_mm;
+  rm.p = out->p_rm_mm * (1.0 / params_.length_unit_mm);
   rm.axis = out->axis_rm;
   return rm;
 }
@@ -319,21 +347,22 @@ ControlStatus Controller::evaluate_with_contact(const RmPose& rm,
   return st;
 }
 
-ControlStatus Controller::saturate_and_map(const Joints& q_dh,
+ControlStatus Controller::saturate_and_map(const Mat3& Jv_arm,
                                            ControlOutput* out) const noexcept {
   ControlStatus st = kStatusOk;
   const OmniParams& omni = params_.omni;
   Vec3 F = out->f_motion.head<3>();
-  const double F_norm = F.norm();
-  if (F_norm > params_.force_limit_N) {
-    F *= params_.force_limit_N / F_norm;
+  // |F| only when over the limit: the square root's latency sat on the
+  // tick's critical path in perf
+  const double F_limit = params_.force_limit_N;
+  if (F.squaredNorm() > F_limit * F_limit) {
+    F *= F_limit / F.norm();
     st |= kStatusForceSaturated;
   }
   // eq. 3.12 with the wrist-centre Jacobian's linear rows (m/rad) and the
   // force in the base frame: tau in N m
   Vec3 F_base = device_to_base_vector(F);
-  const Mat6 Jr = omni_jacobian(omni, q_dh);
-  Vec3 tau = Jr.topLeftCorner<3, 3>().transpose() * F_base;
+  Vec3 tau = Jv_arm.transpose() * F_base;
   Vec3 tau_motor = dh_to_motor_torques(tau);
   // one scale for every motor over its limit keeps the force's direction
   double scale = 1.0;
@@ -367,8 +396,10 @@ ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept 
   ControlStatus st = kStatusOk;
   if (!omni_within_limits(params_.omni, q_dh)) st |= kStatusOutsideJointLimits;
 
-  // 1. the RM: wrist centre and stylus axis in the device frame
-  const RmPose rm = rm_pose(q_dh, out);
+  // 1. the RM: wrist centre and stylus axis in the device frame, and the
+  // arm's Jacobian for step 5, in one pass over the chain
+  const OmniArmKinematics arm = omni_arm_kinematics(params_.omni, q_dh);
+  const RmPose rm = rm_pose(arm, out);
   // 2. theta_R: the VM aligned with the stylus (kept where undefined)
   if (!vm_->aligned(rm, &theta_r_)) st |= kStatusOrientationDegenerate;
   // 3-4. placement, error and projected force
@@ -387,7 +418,7 @@ ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept 
     reset();
     return out->status;
   }
-  st |= saturate_and_map(q_dh, out);
+  st |= saturate_and_map(arm.Jv_arm, out);
   out->status = st;
   return st;
 }

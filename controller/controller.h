@@ -31,6 +31,7 @@
 #include <memory>
 
 #include "controller/control_law.h"
+#include "controller/omni_kinematics.h"
 #include "controller/omni_params.h"
 #include "controller/virtual_mechanism.h"
 
@@ -188,11 +189,17 @@ class Controller {
   // evaluate, and for a VM with a contact, hold, slide or open it
   ControlStatus evaluate_with_contact(const RmPose& rm,
                                       ControlOutput* out) noexcept;
-  // the RM's pose from the DH joints (also into *out's p_rm_mm, axis_rm)
-  RmPose rm_pose(const Joints& q_dh, ControlOutput* out) const noexcept;
+  // r^T W r of the placement residual at the placed pose (closed form)
+  double closed_form_cost(const VmPose& vm_pose,
+                          const RmPose& rm) const noexcept;
+  // the RM's pose from the arm's one-pass kinematics (also into *out's
+  // p_rm_mm, axis_rm)
+  RmPose rm_pose(const OmniArmKinematics& arm,
+                 ControlOutput* out) const noexcept;
   // rows 0-2 of f_motion saturated to the force limit, tau = J_r^T F
-  // (eq. 3.12), the motor torques scaled into their limits
-  ControlStatus saturate_and_map(const Joints& q_dh,
+  // (eq. 3.12, J_r the wrist centre's Jacobian for q1..q3 from the same
+  // pass as the pose), the motor torques scaled into their limits
+  ControlStatus saturate_and_map(const Mat3& Jv_arm,
                                  ControlOutput* out) const noexcept;
   // a non-finite joint angle: zero output, restart e_dot
   ControlStatus fail_input(ControlOutput* out) noexcept;

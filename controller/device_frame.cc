@@ -2,16 +2,6 @@
 
 namespace vmh {
 
-namespace {
-
-// DH base point (m) that the device frame calls its origin: the wrist centre
-// at q = 0, (l1, 0, l0 - l2) by eq. B.14
-Vec3 device_origin_base_m(const OmniParams& p) {
-  return Vec3(p.l1_m, 0.0, p.l0_m - p.l2_m);
-}
-
-}  // namespace
-
 Joints device_to_dh_joints(const Joints& t) {
   Joints q;
   q << -t[0], t[1], t[2] - t[1], -t[3], t[4], -t[5];
@@ -37,36 +27,13 @@ void device_joint_ranges(const OmniParams& params, Joints* lower_device_rad,
   *upper_device_rad = a.cwiseMax(b);
 }
 
-Vec3 dh_to_motor_torques(const Vec3& tau) {
-  return Vec3(-tau[0], tau[1] - tau[2], tau[2]);
-}
-
 Vec3 motor_to_dh_torques(const Vec3& m) {
   return Vec3(-m[0], m[1] + m[2], m[2]);
-}
-
-Mat3 R_device_base() {
-  Mat3 R;
-  // rows: x_dev = y_base, y_dev = z_base, z_dev = x_base
-  R << 0, 1, 0,  //
-      0, 0, 1,   //
-      1, 0, 0;
-  return R;
-}
-
-Vec3 base_to_device_mm(const OmniParams& p, const Vec3& p_base_m) {
-  return kMmPerM * (R_device_base() * (p_base_m - device_origin_base_m(p)));
 }
 
 Vec3 device_mm_to_base(const OmniParams& p, const Vec3& p_device_mm) {
   return R_device_base().transpose() * (p_device_mm / kMmPerM) +
          device_origin_base_m(p);
-}
-
-Vec3 base_to_device_vector(const Vec3& v) { return R_device_base() * v; }
-
-Vec3 device_to_base_vector(const Vec3& v) {
-  return R_device_base().transpose() * v;
 }
 
 Mat3 base_to_device_rotation(const Mat3& R_base) {

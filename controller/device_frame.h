@@ -47,20 +47,41 @@ void device_joint_ranges(const OmniParams& params, Joints* lower_device_rad,
 // power (tau_dh . dq = tau_motor . dt under the joint map above) the motor
 // torques are (-tau1, tau2 - tau3, tau3), and back tau_dh =
 // (-m1, m2 + m3, m3).
-Vec3 dh_to_motor_torques(const Vec3& tau_dh_Nm);
+inline Vec3 dh_to_motor_torques(const Vec3& tau) {
+  return Vec3(-tau[0], tau[1] - tau[2], tau[2]);
+}
 Vec3 motor_to_dh_torques(const Vec3& tau_motor_Nm);
 
 // Rotation taking DH base-frame components to device-frame components.
-Mat3 R_device_base();
+// (inline, with the conversions below that the servo tick calls, so that a
+// tick pays no call for a permutation)
+inline Mat3 R_device_base() {
+  Mat3 R;
+  // rows: x_dev = y_base, y_dev = z_base, z_dev = x_base
+  R << 0, 1, 0,  //
+      0, 0, 1,   //
+      1, 0, 0;
+  return R;
+}
+
+// DH base point (m) that the device frame calls its origin: the wrist centre
+// at q = 0, (l1, 0, l0 - l2) by eq. B.14
+inline Vec3 device_origin_base_m(const OmniParams& p) {
+  return Vec3(p.l1_m, 0.0, p.l0_m - p.l2_m);
+}
 
 // Points: DH base frame (m) <-> device frame (mm).
-Vec3 base_to_device_mm(const OmniParams& params, const Vec3& p_base_m);
+inline Vec3 base_to_device_mm(const OmniParams& p, const Vec3& p_base_m) {
+  return kMmPerM * (R_device_base() * (p_base_m - device_origin_base_m(p)));
+}
 Vec3 device_mm_to_base(const OmniParams& params, const Vec3& p_device_mm);
 
 // Free vectors (directions, forces): DH base frame <-> device frame. Units
 // are unchanged.
-Vec3 base_to_device_vector(const Vec3& v_base);
-Vec3 device_to_base_vector(const Vec3& v_device);
+inline Vec3 base_to_device_vector(const Vec3& v) { return R_device_base() * v; }
+inline Vec3 device_to_base_vector(const Vec3& v) {
+  return R_device_base().transpose() * v;
+}
 
 // Rotations (e.g. the stylus frame) expressed in the other frame.
 Mat3 base_to_device_rotation(const Mat3& R_base);

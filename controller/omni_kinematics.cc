@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "controller/trig.h"
+
 namespace vmh {
 
 namespace {
@@ -45,6 +47,10 @@ void push_unique(const OmniParams& params, const Joints& q, IkSolutions* out) {
 double wrap_angle(double a) {
   // the common case costs two comparisons; NaN fails them and passes through
   if (a > -kPi && a <= kPi) return a;
+  // one turn off (a difference of two wrapped angles): subtracting 2 pi is
+  // exact there (Sterbenz) and is what remainder() returns, without its call
+  if (a > kPi && a < 2.5 * kPi) return a - 2.0 * kPi;
+  if (a <= -kPi && a > -2.5 * kPi) return a + 2.0 * kPi;
   if (!std::isfinite(a)) return a;
   // remainder() gives [-pi, pi]; move -pi to +pi for a half-open range
   double w = std::remainder(a, 2.0 * kPi);
@@ -127,6 +133,103 @@ Mat6 omni_jacobian_at(const OmniParams& params, const Joints& q,
 
 Mat6 omni_jacobian(const OmniParams& params, const Joints& q) {
   return omni_jacobian_at(params, q, 0.0);
+}
+
+namespace {
+
+// The chain of Table B.1 in closed form. With c_i = cos q_i, s_i = sin q_i
+// and q23 = q2 + q3, composing RotX(alpha) RotZ(theta) for alpha in
+// {0, +-pi/2} only permutes and negates columns, so every frame axis is a
+// short sum of the previous frame's axes:
+//   z1 = (0, 0, 1),  z2 = z3 = (s1, -c1, 0),
+//   x3 = (c1 c23, s1 c23, s23), y3 = (-c1 s23, -s1 s23, c23),
+//   z4 = -y3,  x4 = c4 x3 + s4 z3,  y4 = -s4 x3 + c4 z3,
+//   (theta5 = q5 - pi/2)  x5 = s5 x4 + c5 z4,  y5 = c5 x4 - s5 z4,  z5 = y4,
+//   (theta6 = q6 + pi/2)  x6 = -s6 x5 - c6 z5,  y6 = -c6 x5 + s6 z5,  z6 = y5,
+// and the origins o1 = o2 = (0, 0, l0), o3 = o2 + l1 x2 with
+// x2 = (c1 c2, s1 c2, s2), o4 = o5 = o6 = o3 - l2 y3 (the wrist centre).
+struct ClosedChain {
+  double c1, s1;
+  Vec3 z2, x3, y3, z4;  // y3, z4: forearm; x3: elbow
+  Vec3 o1, o3, p;       // joint-1/2 origin, elbow, wrist centre
+};
+
+ClosedChain arm_chain(const OmniParams& params, const Joints& q) {
+  ClosedChain k;
+  const SinCos t1 = sin_cos(q[0]), t2 = sin_cos(q[1]),
+               t23 = sin_cos(q[1] + q[2]);
+  k.c1 = t1.c;
+  k.s1 = t1.s;
+  const double c2 = t2.c, s2 = t2.s;
+  const double c23 = t23.c, s23 = t23.s;
+  const double c1 = k.c1, s1 = k.s1;
+  k.z2 = Vec3(s1, -c1, 0.0);
+  k.x3 = Vec3(c1 * c23, s1 * c23, s23);
+  k.y3 = Vec3(-c1 * s23, -s1 * s23, c23);
+  k.z4 = -k.y3;
+  k.o1 = Vec3(0.0, 0.0, params.l0_m);
+  k.o3 = k.o1 + params.l1_m * Vec3(c1 * c2, s1 * c2, s2);
+  k.p = k.o3 - params.l2_m * k.y3;
+  return k;
+}
+
+}  // namespace
+
+void omni_fk_jacobian(const OmniParams& params, const Joints& q,
+                      OmniPose* pose, Mat6* J, double offset_m) {
+  const ClosedChain k = arm_chain(params, q);
+  const SinCos t4 = sin_cos(q[3]), t5 = sin_cos(q[4]), t6 = sin_cos(q[5]);
+  const double c4 = t4.c, s4 = t4.s;
+  const double c5 = t5.c, s5 = t5.s;
+  const double c6 = t6.c, s6 = t6.s;
+  const Vec3& z3 = k.z2;
+  const Vec3 x4 = c4 * k.x3 + s4 * z3;
+  const Vec3 y4 = -s4 * k.x3 + c4 * z3;
+  const Vec3 x5 = s5 * x4 + c5 * k.z4;
+  const Vec3 y5 = c5 * x4 - s5 * k.z4;
+  const Vec3& z5 = y4;
+  const Vec3& z6 = y5;
+  if (pose != nullptr) {
+    pose->p_base_m = k.p;
+    pose->R_base.col(0) = -s6 * x5 - c6 * z5;
+    pose->R_base.col(1) = -c6 * x5 + s6 * z5;
+    pose->R_base.col(2) = z6;
+  }
+  if (J == nullptr) return;
+  const Vec3 pt = k.p + offset_m * z6;
+  const Vec3 r1 = pt - k.o1;  // o1 = o2
+  const Vec3 r3 = pt - k.o3;
+  const Vec3 rw = offset_m * z6;  // pt - o4 (= o5 = o6)
+  J->block<3, 1>(0, 0) = Vec3(-r1.y(), r1.x(), 0.0);  // z1 x r1
+  J->block<3, 1>(0, 1) = k.z2.cross(r1);
+  J->block<3, 1>(0, 2) = z3.cross(r3);
+  J->block<3, 1>(0, 3) = k.z4.cross(rw);
+  J->block<3, 1>(0, 4) = z5.cross(rw);
+  J->block<3, 1>(0, 5) = z6.cross(rw);
+  J->block<3, 1>(3, 0) = Vec3::UnitZ();
+  J->block<3, 1>(3, 1) = k.z2;
+  J->block<3, 1>(3, 2) = z3;
+  J->block<3, 1>(3, 3) = k.z4;
+  J->block<3, 1>(3, 4) = z5;
+  J->block<3, 1>(3, 5) = z6;
+}
+
+OmniArmKinematics omni_arm_kinematics(const OmniParams& params,
+                                      const Joints& q) {
+  const ClosedChain k = arm_chain(params, q);
+  const SinCos t4 = sin_cos(q[3]), t5 = sin_cos(q[4]);
+  const double c4 = t4.c, s4 = t4.s;
+  const double c5 = t5.c, s5 = t5.s;
+  OmniArmKinematics out;
+  out.p_base_m = k.p;
+  // z6 = y5 = c5 x4 - s5 z4 with x4 = c4 x3 + s4 z3
+  out.z6_base = c5 * (c4 * k.x3 + s4 * k.z2) - s5 * k.z4;
+  const Vec3 r1 = k.p - k.o1;
+  const Vec3 r3 = k.p - k.o3;
+  out.Jv_arm.col(0) = Vec3(-r1.y(), r1.x(), 0.0);
+  out.Jv_arm.col(1) = k.z2.cross(r1);
+  out.Jv_arm.col(2) = k.z2.cross(r3);
+  return out;
 }
 
 const char* ik_status_name(IkStatus s) {

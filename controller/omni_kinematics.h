@@ -67,6 +67,29 @@ Mat6 omni_jacobian(const OmniParams& params, const Joints& q_dh);
 Mat6 omni_jacobian_at(const OmniParams& params, const Joints& q_dh,
                       double offset_m);
 
+// FK and the Jacobian in one pass: the closed form of the chain of
+// Table B.1's products (derived in docs/kinematics.md), with the sines and
+// cosines of q1..q6 computed once and shared, and no 4 x 4 products. Equal to
+// omni_fk and omni_jacobian_at (which compose the chain, omni_frames) within
+// 1e-12 (tests/controller/omni_kinematics_one_pass_test.cc). *J (optional)
+// is the geometric Jacobian at the point offset_m along z6, as
+// omni_jacobian_at. The sines and cosines come from sin_cos
+// (controller/trig.h).
+void omni_fk_jacobian(const OmniParams& params, const Joints& q_dh,
+                      OmniPose* pose, Mat6* J, double offset_m = 0.0);
+
+// What a servo tick needs of the arm, in one pass over q1..q3 and the
+// stylus axis: the wrist centre (m), the stylus axis z6 (the third column of
+// omni_fk's R_base) and the wrist centre's linear Jacobian for q1..q3 (the
+// top-left 3 x 3 of omni_jacobian, m/rad), all in the DH base frame.
+struct OmniArmKinematics {
+  Vec3 p_base_m;
+  Vec3 z6_base;
+  Mat3 Jv_arm;
+};
+OmniArmKinematics omni_arm_kinematics(const OmniParams& params,
+                                      const Joints& q_dh);
+
 // -- inverse kinematics (Pieper: the wrist centre fixes q1..q3, the
 // orientation then fixes q4..q6; eq. B.15-B.53 re-derived, see docs) --
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "controller/omni_kinematics.h"  // wrap_angle
+#include "controller/trig.h"
 
 namespace vmh {
 namespace {
@@ -16,6 +17,10 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegenerateFraction = 1e-9;
 // |sin| below which an axis is treated as lying on a pole
 constexpr double kPoleSin = 1e-12;
+
+// hypot(x, y) > t for t > 0, without hypot's care for overflow: the
+// arguments here are lengths in mm or unit-vector components
+bool above(double x, double y, double t) { return x * x + y * y > t * t; }
 
 double clamp_unit(double x) { return x < -1.0 ? -1.0 : (x > 1.0 ? 1.0 : x); }
 
@@ -45,7 +50,8 @@ Vec3 perpendicular(const Vec3& u) {
 // rotation about the local z axis
 Mat3 rot_z(double a) {
   Mat3 R;
-  const double c = std::cos(a), s = std::sin(a);
+  const SinCos t = sin_cos(a);
+  const double c = t.c, s = t.s;
   R << c, -s, 0, s, c, 0, 0, 0, 1;
   return R;
 }
@@ -198,30 +204,62 @@ Mat3 VirtualMechanism::orientation_error_jacobian(const VmPose& vm,
 CircleVm::CircleVm(const VmMount& mount, double length)
     : VirtualMechanism(mount, length) {}
 
+namespace {
+
+VmPose circle_pose(const VmMount& mount, double length, double c, double s) {
+  // R rot_z(theta) column by column: rot_z mixes only the first two
+  // columns, and the link axis R (c, s, 0) is the first of them, so neither
+  // needs a 3 x 3 product
+  VmPose out;
+  out.R.col(0) = c * mount.R.col(0) + s * mount.R.col(1);
+  out.R.col(1) = c * mount.R.col(1) - s * mount.R.col(0);
+  out.R.col(2) = mount.R.col(2);
+  out.axis = out.R.col(0);
+  out.p = mount.origin + length * out.axis;
+  return out;
+}
+
+void circle_jacobian(const VmMount& mount, double length, double c, double s,
+                     VmJacobian* J) {
+  J->resize(6, 1);
+  J->block<3, 1>(0, 0) = mount.R * Vec3(-length * s, length * c, 0.0);
+  J->block<3, 1>(3, 0) = mount.R.col(2);
+}
+
+}  // namespace
+
+void CircleVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
+                             VmJacobian* J) const {
+  const SinCos t = sin_cos(theta[0]);
+  const double c = t.c, s = t.s;
+  *pose = circle_pose(mount_, length_, c, s);
+  circle_jacobian(mount_, length_, c, s, J);
+}
+
+Vec3 CircleVm::position(const VmAngles& theta) const {
+  const SinCos t = sin_cos(theta[0]);
+  const double c = t.c, s = t.s;
+  return mount_.origin + length_ * (mount_.R * Vec3(c, s, 0.0));
+}
+
 VmPose CircleVm::pose(const VmAngles& theta) const {
   // eq. 3.25/3.26 in the pivot frame, then into the device frame
-  const double c = std::cos(theta[0]), s = std::sin(theta[0]);
-  VmPose out;
-  out.axis = mount_.R * Vec3(c, s, 0.0);
-  out.p = mount_.origin + length_ * out.axis;
-  out.R = mount_.R * rot_z(theta[0]);
-  return out;
+  const SinCos t = sin_cos(theta[0]);
+  const double c = t.c, s = t.s;
+  return circle_pose(mount_, length_, c, s);
 }
 
 void CircleVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
   // eq. 3.27: (-L sin, L cos, 0, 0, 0, 1) in the pivot frame
-  const double c = std::cos(theta[0]), s = std::sin(theta[0]);
-  J->resize(6, 1);
-  J->block<3, 1>(0, 0) = mount_.R * Vec3(-length_ * s, length_ * c, 0.0);
-  J->block<3, 1>(3, 0) = mount_.R.col(2);
+  const SinCos t = sin_cos(theta[0]);
+  const double c = t.c, s = t.s;
+  circle_jacobian(mount_, length_, c, s, J);
 }
 
 bool CircleVm::nearest(const RmPose& rm, VmAngles* theta) const {
   // §3.3.1: theta_V = atan2(Y - Y0, X - X0), in the pivot frame
   const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
-  if (!(std::hypot(d.x(), d.y()) > kDegenerateFraction * length_)) {
-    return false;
-  }
+  if (!above(d.x(), d.y(), kDegenerateFraction * length_)) return false;
   (*theta)[0] = std::atan2(d.y(), d.x());
   return true;
 }
@@ -229,7 +267,7 @@ bool CircleVm::nearest(const RmPose& rm, VmAngles* theta) const {
 bool CircleVm::aligned(const RmPose& rm, VmAngles* theta) const {
   // §3.3.1: theta_R = atan2(Z_y, Z_x) of the stylus z axis
   const Vec3 a = mount_.R.transpose() * rm.axis;
-  if (!(std::hypot(a.x(), a.y()) > kPoleSin)) return false;
+  if (!above(a.x(), a.y(), kPoleSin)) return false;
   (*theta)[0] = std::atan2(a.y(), a.x());
   return true;
 }
@@ -269,27 +307,36 @@ void CircleVm::normalize(VmAngles* theta) const {
 SphereVm::SphereVm(const VmMount& mount, double length)
     : VirtualMechanism(mount, length) {}
 
-VmPose SphereVm::pose(const VmAngles& theta) const {
+namespace {
+
+struct SphereTrig {
+  double s1, c1, s2, c2;
+  explicit SphereTrig(const VmAngles& theta)
+      : SphereTrig(sin_cos(theta[0]), sin_cos(theta[1])) {}
+  SphereTrig(SinCos t1, SinCos t2) : s1(t1.s), c1(t1.c), s2(t2.s), c2(t2.c) {}
+};
+
+VmPose sphere_pose(const VmMount& mount, double length, const SphereTrig& t,
+                   double theta3) {
   // eq. 3.29/3.30 in the pivot frame
-  const double s1 = std::sin(theta[0]), c1 = std::cos(theta[0]);
-  const double s2 = std::sin(theta[1]), c2 = std::cos(theta[1]);
-  const double s3 = std::sin(theta[2]), c3 = std::cos(theta[2]);
+  const double s1 = t.s1, c1 = t.c1, s2 = t.s2, c2 = t.c2;
+  const SinCos t3 = sin_cos(theta3);
+  const double s3 = t3.s, c3 = t3.c;
   Mat3 R;
   R << s1 * s3 + c1 * c2 * c3, s1 * c3 - c1 * c2 * s3, c1 * s2,  //
       s1 * c2 * c3 - c1 * s3, -c1 * c3 - s1 * c2 * s3, s1 * s2,  //
       s2 * c3, -s2 * s3, -c2;
   VmPose out;
-  out.R = mount_.R * R;
+  out.R = mount.R * R;
   out.axis = out.R.col(2);
-  out.p = mount_.origin + length_ * out.axis;
+  out.p = mount.origin + length * out.axis;
   return out;
 }
 
-void SphereVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
+void sphere_jacobian(const VmMount& mount, double L, const SphereTrig& t,
+                     VmJacobian* J) {
   // eq. 3.31 in the pivot frame
-  const double s1 = std::sin(theta[0]), c1 = std::cos(theta[0]);
-  const double s2 = std::sin(theta[1]), c2 = std::cos(theta[1]);
-  const double L = length_;
+  const double s1 = t.s1, c1 = t.c1, s2 = t.s2, c2 = t.c2;
   Eigen::Matrix<double, 6, 3> Jl;
   Jl << -L * s1 * s2, L * c1 * c2, 0,  //
       L * c1 * s2, L * s1 * c2, 0,     //
@@ -298,8 +345,32 @@ void SphereVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
       0, -c1, s1 * s2,                 //
       1, 0, -c2;
   J->resize(6, 3);
-  J->topRows<3>() = mount_.R * Jl.topRows<3>();
-  J->bottomRows<3>() = mount_.R * Jl.bottomRows<3>();
+  J->topRows<3>() = mount.R * Jl.topRows<3>();
+  J->bottomRows<3>() = mount.R * Jl.bottomRows<3>();
+}
+
+}  // namespace
+
+Vec3 SphereVm::position(const VmAngles& theta) const {
+  // the link axis, column 3 of eq. 3.29's rotation: no twist needed
+  const SphereTrig t(theta);
+  return mount_.origin +
+         length_ * (mount_.R * Vec3(t.c1 * t.s2, t.s1 * t.s2, -t.c2));
+}
+
+VmPose SphereVm::pose(const VmAngles& theta) const {
+  return sphere_pose(mount_, length_, SphereTrig(theta), theta[2]);
+}
+
+void SphereVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
+  sphere_jacobian(mount_, length_, SphereTrig(theta), J);
+}
+
+void SphereVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
+                             VmJacobian* J) const {
+  const SphereTrig t(theta);
+  *pose = sphere_pose(mount_, length_, t, theta[2]);
+  sphere_jacobian(mount_, length_, t, J);
 }
 
 namespace {
@@ -308,7 +379,7 @@ namespace {
 // on the pole axis theta1 is left as it was
 void sphere_angles(const Vec3& d, VmAngles* theta) {
   (*theta)[1] = std::acos(clamp_unit(-d.z()));
-  if (std::hypot(d.x(), d.y()) > kPoleSin) {
+  if (above(d.x(), d.y(), kPoleSin)) {
     (*theta)[0] = std::atan2(d.y(), d.x());
   }
 }
@@ -365,8 +436,9 @@ VmPose SurfaceVm::pose(const VmAngles& theta) const {
   // frame = Rx(alpha) Rz(beta) C Rz(gamma) in the plane frame, with C the
   // constant rotation taking (x, y, z) to (y, z, x); its z column is
   // u = (cos b, sin b cos a, sin b sin a)
-  const double sa = std::sin(theta[2]), ca = std::cos(theta[2]);
-  const double sb = std::sin(theta[3]), cb = std::cos(theta[3]);
+  const SinCos ta = sin_cos(theta[2]), tb = sin_cos(theta[3]);
+  const double sa = ta.s, ca = ta.c;
+  const double sb = tb.s, cb = tb.c;
   Mat3 F;
   F.col(0) = Vec3(-sb, cb * ca, cb * sa);  // du/dbeta
   F.col(2) = Vec3(cb, sb * ca, sb * sa);   // u
@@ -379,8 +451,9 @@ VmPose SurfaceVm::pose(const VmAngles& theta) const {
 }
 
 void SurfaceVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
-  const double sa = std::sin(theta[2]), ca = std::cos(theta[2]);
-  const double sb = std::sin(theta[3]), cb = std::cos(theta[3]);
+  const SinCos ta = sin_cos(theta[2]), tb = sin_cos(theta[3]);
+  const double sa = ta.s, ca = ta.c;
+  const double sb = tb.s, cb = tb.c;
   const Vec3 t1 = mount_.R.col(0);
   const Vec3 u = mount_.R * Vec3(cb, sb * ca, sb * sa);
   const Vec3 w_beta = mount_.R * Vec3(0.0, -sa, ca);

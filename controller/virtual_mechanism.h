@@ -101,6 +101,19 @@ class VirtualMechanism {
   // unit per rad, or per length unit for a prismatic joint), rows 3-5 angular
   // velocity (rad per rad); device frame
   virtual void jacobian(const VmAngles& theta, VmJacobian* J) const = 0;
+  // X_V(theta)'s position alone (pose(theta).p), for a VM that can skip
+  // the rest
+  virtual Vec3 position(const VmAngles& theta) const {
+    return pose(theta).p;
+  }
+  // both at one theta (what a servo tick needs), sharing their sines and
+  // cosines where a VM overrides it; the same numbers as pose() and
+  // jacobian()
+  virtual void pose_jacobian(const VmAngles& theta, VmPose* pose,
+                             VmJacobian* J) const {
+    *pose = this->pose(theta);
+    jacobian(theta, J);
+  }
 
   // Closed-form placements (§3.2). `nearest` puts the handle at the point of
   // the VM's path closest to the RM's position (weight W_p, eq. 3.21-3.24,
@@ -183,6 +196,9 @@ class CircleVm final : public VirtualMechanism {
   int dof() const override { return 1; }
   VmPose pose(const VmAngles& theta) const override;
   void jacobian(const VmAngles& theta, VmJacobian* J) const override;
+  void pose_jacobian(const VmAngles& theta, VmPose* pose,
+                     VmJacobian* J) const override;
+  Vec3 position(const VmAngles& theta) const override;
   bool nearest(const RmPose& rm, VmAngles* theta) const override;
   bool aligned(const RmPose& rm, VmAngles* theta) const override;
   Vec3 thesis_orientation_error(const VmAngles& theta_v,
@@ -204,6 +220,9 @@ class SphereVm final : public VirtualMechanism {
   int dof() const override { return 3; }
   VmPose pose(const VmAngles& theta) const override;
   void jacobian(const VmAngles& theta, VmJacobian* J) const override;
+  void pose_jacobian(const VmAngles& theta, VmPose* pose,
+                     VmJacobian* J) const override;
+  Vec3 position(const VmAngles& theta) const override;
   bool nearest(const RmPose& rm, VmAngles* theta) const override;
   bool aligned(const RmPose& rm, VmAngles* theta) const override;
   Vec3 thesis_orientation_error(const VmAngles& theta_v,

@@ -347,7 +347,9 @@ void ClosedLoop::tick(TraceRow* row) {
   row->d_path_mm = distance_to_path_mm(row->out.p_rm_mm);
   const OmniParams& omni = params_.omni;
   row->q_true_dh = device_->true_q_dh();
-  row->p_true_mm = base_to_device_mm(omni, omni_fk(omni, row->q_true_dh).p_base_m);
+  OmniPose pose_true;
+  omni_fk_jacobian(omni, row->q_true_dh, &pose_true, nullptr);
+  row->p_true_mm = base_to_device_mm(omni, pose_true.p_base_m);
   row->nearest_true_mm = nearest_on_path_mm(row->p_true_mm);
 
   mjModel* m = model_.get();

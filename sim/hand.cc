@@ -142,6 +142,20 @@ SimHand::SimHand(mjModel* m, mjData* d, const HandParams& params,
   mju_mat2Quat(m->body_iquat + 4 * b, axes_row.data());
   mj_setConst(m, d);
 
+  // the joints the grip's wrench acts on, if all are hinges
+  chain_count_ = 0;
+  for (int body = grip_body_; body > 0 && chain_count_ >= 0;
+       body = m->body_parentid[body]) {
+    for (int k = 0; k < m->body_jntnum[body]; ++k) {
+      const int j = m->body_jntadr[body] + k;
+      if (m->jnt_type[j] != mjJNT_HINGE || chain_count_ == kMaxChain) {
+        chain_count_ = -1;
+        break;
+      }
+      chain_joint_[chain_count_++] = j;
+    }
+  }
+
   register_hand(d, this, source);
   data_ = d;
 }
@@ -175,8 +189,20 @@ void SimHand::apply(const mjModel* m, mjData* d) {
              params_.b_pos_Ns_per_m * (target_.v_m_s - v);
   torque_Nm_ = params_.k_rot_Nm_per_rad * rotvec +
                params_.b_rot_Nms_per_rad * (target_.w_rad_s - w);
-  mj_applyFT(m, d, force_N_.data(), torque_Nm_.data(), p.data(), grip_body_,
-             d->qfrc_applied);
+  if (chain_count_ < 0) {
+    mj_applyFT(m, d, force_N_.data(), torque_Nm_.data(), p.data(),
+               grip_body_, d->qfrc_applied);
+    return;
+  }
+  // J^T [F; tau] over the hinge chain: a hinge with world axis a through
+  // the anchor c has Jacobian column (a x (p - c); a)
+  for (int k = 0; k < chain_count_; ++k) {
+    const int j = chain_joint_[k];
+    const Eigen::Map<const Vec3> axis(d->xaxis + 3 * j);
+    const Eigen::Map<const Vec3> anchor(d->xanchor + 3 * j);
+    d->qfrc_applied[m->jnt_dofadr[j]] +=
+        axis.dot(torque_Nm_ + (p - anchor).cross(force_N_));
+  }
 }
 
 }  // namespace vmh::sim

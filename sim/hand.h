@@ -94,6 +94,14 @@ class SimHand {
   const mjData* data_ = nullptr;
   int grip_site_ = -1;
   int grip_body_ = -1;
+  // the hinge joints between the grip's body and the world, when every
+  // joint there is a hinge (the Omni's chain): apply() maps the wrench to
+  // them as axis . (tau + (p - anchor) x F), the same J^T [F; tau] that
+  // mj_applyFT forms through mj_jac, without its stack and its loop over
+  // the whole tree. chain_count_ < 0: some other joint, so mj_applyFT.
+  static constexpr int kMaxChain = 16;
+  int chain_joint_[kMaxChain] = {};
+  int chain_count_ = -1;
   int target_mocap_ = -1;
   HandTargetState target_;
   Vec3 force_N_ = Vec3::Zero();

@@ -105,6 +105,19 @@ TEST(NoAlloc, Jacobian) {
   EXPECT_TRUE(std::isfinite(sink));
 }
 
+TEST(NoAlloc, OnePassKinematics) {
+  const OmniParams p;
+  double sink = 0;
+  expect_no_alloc([&](const Joints& q) {
+    OmniPose pose;
+    Mat6 J;
+    omni_fk_jacobian(p, q, &pose, &J, -0.03);
+    const OmniArmKinematics arm = omni_arm_kinematics(p, q);
+    sink += pose.p_base_m.sum() + J.sum() + arm.Jv_arm.sum();
+  });
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
 TEST(NoAlloc, InverseKinematics) {
   const OmniParams p;
   int found = 0;
