@@ -61,7 +61,7 @@ SweepValue at_unit(const SweepParameter& p, double u) {
     }
     case SweepScale::kChoice: {
       const std::size_t n = p.choices.size();
-      v.text = p.choices[std::min(n - 1, static_cast<std::size_t>(u * n))];
+      v.text = p.choices[std::min(n - 1, static_cast<std::size_t>(u * static_cast<double>(n)))];
       break;
     }
   }
