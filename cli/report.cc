@@ -299,6 +299,7 @@ void run(const ReportCli& o) {
   out["cases"] = names;
   out["claims_passed"] = tally.passed;
   out["claims_total"] = tally.total;
+  out["claims_partial"] = tally.partial;
   out["reused"] = reused;
   out["ran"] = ran;
   out["wall_s"] = h.wall_s;

@@ -4,6 +4,10 @@
 #include <cmath>
 #include <set>
 
+#include "controller/device_frame.h"
+#include "controller/omni_kinematics.h"
+#include "studies/law_prediction.h"
+
 namespace vmh::studies {
 // the testbed's types (sim/) by their own names in this file
 using namespace vmh::sim;  // NOLINT(build/namespaces)
@@ -116,6 +120,40 @@ RunMetrics run_metrics(const std::vector<TraceRow>& rows,
   return m;
 }
 
+void merge_sides(std::vector<Claim>* first, const std::string& where_first,
+                 const std::vector<Claim>& second,
+                 const std::string& where_second) {
+  const auto side = [](const Claim& c, const std::string& where) {
+    Claim::Side s;
+    s.where = where;
+    s.value = c.value;
+    s.pass = c.pass;
+    s.prediction = c.prediction;
+    s.matches_prediction = c.matches_prediction;
+    s.regime = c.regime;
+    s.mean_path_distance_mm = c.mean_path_distance_mm;
+    return s;
+  };
+  for (Claim& c : *first) {
+    const auto other =
+        std::find_if(second.begin(), second.end(),
+                     [&](const Claim& o) { return o.name == c.name; });
+    c.sides = {side(c, where_first)};
+    if (other != second.end()) c.sides.push_back(side(*other, where_second));
+    int held = 0;
+    std::string where;
+    for (const Claim::Side& s : c.sides) {
+      if (!s.pass) continue;
+      ++held;
+      where += (where.empty() ? "" : "; ") + s.where;
+    }
+    const int n = static_cast<int>(c.sides.size());
+    c.pass = held == n;
+    c.partial = held > 0 && held < n;
+    c.holds_where = c.partial ? where : "";
+  }
+}
+
 std::optional<ControllerParams> reference_params(int thesis_case,
                                                  const ControllerParams& p) {
   if (thesis_case != 3 && thesis_case != 4) return std::nullopt;
@@ -128,16 +166,47 @@ std::optional<ControllerParams> reference_params(int thesis_case,
 
 namespace {
 
+// the law's prediction at every row's ground-truth pose (index as rows)
+class Predictions {
+ public:
+  Predictions(const std::vector<TraceRow>& rows, const ControllerParams& p)
+      : rows_(&rows), p_(p) {
+    at_.reserve(rows.size());
+    for (const TraceRow& r : rows) at_.push_back(predict(r, p));
+  }
+  const LawPrediction& at(const TraceRow* r) const {
+    return at_[static_cast<std::size_t>(r - rows_->data())];
+  }
+  // the ground-truth pose of a row, device frame
+  static LawPrediction predict(const TraceRow& r, const ControllerParams& p) {
+    const OmniPose pose = omni_fk(p.omni, r.q_true_dh);
+    return predict_static_law(p, base_to_device_mm(p.omni, pose.p_base_m),
+                              base_to_device_vector(pose.R_base.col(2)),
+                              r.q_true_dh);
+  }
+  static Vec3 p_true_mm(const TraceRow& r, const ControllerParams& p) {
+    return base_to_device_mm(p.omni, omni_fk(p.omni, r.q_true_dh).p_base_m);
+  }
+  const ControllerParams& params() const { return p_; }
+
+ private:
+  const std::vector<TraceRow>* rows_;
+  ControllerParams p_;
+  std::vector<LawPrediction> at_;
+};
+
 std::vector<Claim> measure_claims(int thesis_case,
                                   const std::vector<TraceRow>& rows,
-                                  const ClosedLoop& loop);
+                                  const ClosedLoop& loop,
+                                  const Predictions& pred);
 
 }  // namespace
 
 std::vector<Claim> evaluate_claims(int thesis_case,
                                    const std::vector<TraceRow>& rows,
                                    const ClosedLoop& loop) {
-  std::vector<Claim> claims = measure_claims(thesis_case, rows, loop);
+  const Predictions pred(rows, loop.controller_params());
+  std::vector<Claim> claims = measure_claims(thesis_case, rows, loop, pred);
   for (Claim& c : claims) {
     std::set<std::string> names;
     std::size_t start = 0;
@@ -150,45 +219,86 @@ std::vector<Claim> evaluate_claims(int thesis_case,
     // the sweep claim uses the whole segment, the others its settled half
     const bool whole = names.count("sweep") > 0;
     double sum = 0.0;
-    int n = 0;
+    int n = 0, limited = 0;
     for (const TraceRow& r : rows) {
       const ScriptSegment& s =
           loop.script().segments()[static_cast<std::size_t>(r.segment)];
       if (names.count(s.name) && (whole || r.t_s >= s.settled_from_s())) {
         sum += r.d_path_mm;
         ++n;
+        if (r.out.status & (kStatusForceSaturated | kStatusTorqueSaturated)) {
+          ++limited;
+        }
       }
     }
     c.mean_path_distance_mm = n > 0 ? sum / n : std::nan("");
+    c.saturated_fraction = n > 0 ? static_cast<double>(limited) / n : 0.0;
+    c.regime = c.saturated_fraction >= 0.5 ? "saturated" : "linear";
+    if (c.prediction) {
+      c.matches_prediction = std::isfinite(c.value) && std::isfinite(*c.prediction) &&
+                             std::abs(c.value - *c.prediction) <= c.tolerance;
+    }
   }
   return claims;
 }
 
 namespace {
 
-// Cases 1 and 5, position error only: no force on the path, off it a force
-// toward X(theta_V), and none from X(theta_R).
+// the prediction of claim c: `value` computed the same way on the law's
+// predicted forces; none (with the note) where no row had a prediction
+void set_prediction(Claim* c, double value, int n, double tolerance,
+                    const std::string& note) {
+  if (n > 0 && std::isfinite(value)) {
+    c->prediction = value;
+    c->tolerance = tolerance;
+    c->prediction_note = note;
+  } else {
+    c->prediction_note =
+        "none: the law has no closed-form prediction at these poses (" +
+        note + ")";
+  }
+}
+
+constexpr const char* kStaticNote =
+    "the static law (e_dot = 0) at the ground-truth poses, closed-form "
+    "placement, limits included (studies/law_prediction.h)";
+
+// Cases 1 and 5, position error only: no force on the path, and off it a
+// force toward X(theta_V). (The thesis's third statement, "independent of
+// X(theta_R)", is the first one again: with K_ornt = 0 nothing in the law
+// reads X(theta_R), so on the path the force is K_pos times the distance.)
 void position_claims(const std::vector<TraceRow>& rows, const HandScript& script,
-                     const ControllerParams& p, std::vector<Claim>* claims_out) {
+                     const Predictions& pred, std::vector<Claim>* claims_out) {
   std::vector<Claim>& claims = *claims_out;
+  const ControllerParams& p = pred.params();
   const std::set<std::string> off = {"off_out", "off_out_misaligned", "off_in"};
   const std::set<std::string> on = {"on_misaligned_a", "on_misaligned_b"};
   {
     const auto w = settled(rows, script, on);
-    std::vector<double> f;
-    for (const TraceRow* r : w) f.push_back(r->out.force_device_N.norm());
-    claims.push_back(make(
+    std::vector<double> f, fp;
+    for (const TraceRow* r : w) {
+      f.push_back(r->out.force_device_N.norm());
+      const LawPrediction& lp = pred.at(r);
+      if (lp.available) fp.push_back(lp.force_limited_N.norm());
+    }
+    Claim c = make(
         "on_path_no_force",
         "with the RM on the path there is no force (the stylus misaligned)",
-        on, mean_of(f), "<=", 0.05, "N", static_cast<int>(w.size())));
+        on, mean_of(f), "<=", 0.05, "N", static_cast<int>(w.size()));
+    const double pr = mean_of(fp);
+    set_prediction(&c, pr, static_cast<int>(fp.size()),
+                   std::max(0.01, 0.1 * pr),
+                   std::string("mean |F| of ") + kStaticNote +
+                       ": K_pos times the distance from the path");
+    claims.push_back(c);
   }
   {
     // measured against the ground truth: the true wrist centre and the
     // closed-form nearest point of the path, not the controller's own
     // (quantised, Gauss-Newton) X(theta_V)
     const auto w = settled(rows, script, off);
-    double worst = 0.0;
-    int n = 0;
+    double worst = 0.0, worst_p = 0.0;
+    int n = 0, np = 0;
     for (const TraceRow* r : w) {
       const double a =
           angle_deg(r->out.force_device_N, r->nearest_true_mm - r->p_true_mm);
@@ -196,172 +306,261 @@ void position_claims(const std::vector<TraceRow>& rows, const HandScript& script
         worst = std::max(worst, a);
         ++n;
       }
+      const LawPrediction& lp = pred.at(r);
+      const double ap =
+          lp.available
+              ? angle_deg(lp.force_limited_N,
+                          lp.x_v_mm - Predictions::p_true_mm(*r, p))
+              : std::nan("");
+      if (std::isfinite(ap)) {
+        worst_p = std::max(worst_p, ap);
+        ++np;
+      }
     }
-    claims.push_back(make(
+    Claim c = make(
         "off_path_force_toward_xv",
         "off the path the force is normal to it and pulls toward X(theta_V) "
         "(max angle from the true nearest point)",
-        off, n > 0 ? worst : std::nan(""), "<=", 2.0, "deg", n));
-  }
-  {
-    // the force compared with what the same gain would give on the error
-    // to X(theta_R): "independent of X(theta_R)"
-    const auto w = settled(rows, script, on);
-    std::vector<double> f, xr;
-    for (const TraceRow* r : w) {
-      f.push_back(r->out.force_device_N.norm());
-      xr.push_back((r->out.x_r_mm - r->out.p_rm_mm).norm());
-    }
-    const double ratio =
-        mean_of(f) / (p.gains.k_pos_N_per_mm * std::max(mean_of(xr), 1e-9));
-    claims.push_back(make(
-        "force_independent_of_xr",
-        "the force does not depend on X(theta_R): |F| / (K_pos |X(theta_R) "
-        "- p|) on the path",
-        on, ratio, "<=", 0.02, "-", static_cast<int>(w.size())));
+        off, n > 0 ? worst : std::nan(""), "<=", 2.0, "deg", n);
+    set_prediction(&c, np > 0 ? worst_p : std::nan(""), np, 2.0,
+                   std::string("max angle of ") + kStaticNote);
+    claims.push_back(c);
   }
 }
 
 // Cases 2, 3, 4 and 6, position and orientation: off the path the force
 // points between X(theta_V) and X(theta_R), on it toward X(theta_R), felt.
 void orientation_claims(const std::vector<TraceRow>& rows,
-                        const HandScript& script,
+                        const HandScript& script, const Predictions& pred,
                         std::vector<Claim>* claims_out) {
   std::vector<Claim>& claims = *claims_out;
+  const ControllerParams& p = pred.params();
   const std::set<std::string> off_mis = {"off_out_misaligned"};
   const std::set<std::string> on = {"on_misaligned_a", "on_misaligned_b"};
+  // between X_V and X_R (from p), nearer X_V
+  const auto between = [](const Vec3& F, const Vec3& x_v, const Vec3& x_r,
+                          const Vec3& pos, bool* ok) {
+    const Vec3 dv = x_v - pos, dr = x_r - pos;
+    const double av = angle_deg(F, dv), ar = angle_deg(F, dr);
+    *ok = std::isfinite(av) && std::isfinite(ar);
+    return F.dot(dv) > 0.0 && F.dot(x_r - x_v) > 0.0 && av < ar;
+  };
   {
     const auto w = settled(rows, script, off_mis);
-    int good = 0, n = 0;
+    int good = 0, n = 0, good_p = 0, np = 0;
     for (const TraceRow* r : w) {
-      const Vec3 F = r->out.force_device_N;
-      const Vec3 dv = r->out.x_v_mm - r->out.p_rm_mm;
-      const Vec3 dr = r->out.x_r_mm - r->out.p_rm_mm;
-      const double av = angle_deg(F, dv), ar = angle_deg(F, dr);
-      if (!std::isfinite(av) || !std::isfinite(ar)) continue;
-      ++n;
-      const bool toward_path = F.dot(dv) > 0.0;
-      const bool toward_xr_side = F.dot(r->out.x_r_mm - r->out.x_v_mm) > 0.0;
-      if (toward_path && toward_xr_side && av < ar) ++good;
+      bool ok = false;
+      const bool g = between(r->out.force_device_N, r->out.x_v_mm,
+                             r->out.x_r_mm, r->out.p_rm_mm, &ok);
+      if (ok) {
+        ++n;
+        good += g ? 1 : 0;
+      }
+      const LawPrediction& lp = pred.at(r);
+      if (!lp.available) continue;
+      const bool gp = between(lp.force_limited_N, lp.x_v_mm, lp.x_r_mm,
+                              Predictions::p_true_mm(*r, p), &ok);
+      if (ok) {
+        ++np;
+        good_p += gp ? 1 : 0;
+      }
     }
-    claims.push_back(make(
+    Claim c = make(
         "off_path_between_nearer_xv",
         "off the path the force points between X(theta_V) and X(theta_R), "
         "nearer X(theta_V): fraction of ticks",
         off_mis, n > 0 ? static_cast<double>(good) / n : std::nan(""), ">=",
-        0.95, "-", n));
+        0.95, "-", n);
+    set_prediction(&c, np > 0 ? static_cast<double>(good_p) / np : std::nan(""),
+                   np, 0.05, std::string("fraction of ticks by ") + kStaticNote);
+    claims.push_back(c);
   }
   {
     // on the path the force moves the RM toward X(theta_R) (cases 2 and 6)
     const auto w = settled(rows, script, on);
-    std::vector<double> f;
-    int toward = 0;
+    std::vector<double> f, fp;
+    int toward = 0, toward_p = 0;
     for (const TraceRow* r : w) {
       const Vec3 F = r->out.force_device_N;
       f.push_back(F.norm());
       if (F.dot(r->out.x_r_mm - r->out.p_rm_mm) > 0.0) ++toward;
+      const LawPrediction& lp = pred.at(r);
+      if (!lp.available) continue;
+      fp.push_back(lp.force_limited_N.norm());
+      if (lp.force_limited_N.dot(lp.x_r_mm - Predictions::p_true_mm(*r, p)) >
+          0.0) {
+        ++toward_p;
+      }
     }
     const int n = static_cast<int>(w.size());
-    claims.push_back(make(
+    const int np = static_cast<int>(fp.size());
+    Claim c = make(
         "on_path_force_toward_xr",
         "on the path the force moves the RM toward X(theta_R): fraction of "
         "ticks with F . (X(theta_R) - p) > 0",
         on, n > 0 ? static_cast<double>(toward) / n : std::nan(""), ">=",
-        0.95, "-", n));
-    claims.push_back(make("on_path_force_felt",
-                          "on the path the orientation error is felt: mean |F|",
-                          on, mean_of(f), ">=", 0.1, "N", n));
+        0.95, "-", n);
+    set_prediction(&c, np > 0 ? static_cast<double>(toward_p) / np : std::nan(""),
+                   np, 0.05, std::string("fraction of ticks by ") + kStaticNote);
+    claims.push_back(c);
+    // felt: at least a tenth of a newton, and the size the law gives
+    Claim felt = make("on_path_force_felt",
+                      "on the path the orientation error is felt: mean |F|",
+                      on, mean_of(f), ">=", 0.1, "N", n);
+    const double pr = mean_of(fp);
+    set_prediction(&felt, pr, np, std::max(0.05, 0.1 * pr),
+                   std::string("mean |F| of ") + kStaticNote);
+    claims.push_back(felt);
   }
+}
+
+// the direction along the path from X_V toward X_R at a predicted pose
+Vec3 along_path_predicted(const LawPrediction& lp, const ControllerParams& p) {
+  Vec3 w = lp.x_r_mm - lp.x_v_mm;
+  const Vec3 radial = (lp.x_v_mm - p.vm.pivot_mm).normalized();
+  w -= w.dot(radial) * radial;
+  if (p.vm.kind == VmKind::kCircle) {
+    const Vec3 n = p.vm.R_pivot.col(2);
+    w -= w.dot(n) * n;
+  }
+  return w;
 }
 
 // Case 2's "bending feel" on a circle: along the path, not across it.
 void along_path_claim(const std::vector<TraceRow>& rows, const HandScript& script,
-                      const ControllerParams& p, std::vector<Claim>* claims) {
+                      const Predictions& pred, std::vector<Claim>* claims) {
+  const ControllerParams& p = pred.params();
   const std::set<std::string> on = {"on_misaligned_a", "on_misaligned_b"};
   const auto w = settled(rows, script, on);
-  std::vector<double> a;
+  std::vector<double> a, ap;
   for (const TraceRow* r : w) {
     const double x =
         angle_deg(r->out.force_device_N, along_path_toward_xr(*r, p));
     if (std::isfinite(x)) a.push_back(x);
+    const LawPrediction& lp = pred.at(r);
+    if (!lp.available) continue;
+    const double y =
+        angle_deg(lp.force_limited_N, along_path_predicted(lp, p));
+    if (std::isfinite(y)) ap.push_back(y);
   }
-  claims->push_back(make(
+  Claim c = make(
       "on_path_force_along_path",
       "on the path the force runs along the path toward X(theta_R), a "
       "bending feel: mean angle from the path's tangent",
-      on, mean_of(a), "<=", 25.0, "deg", static_cast<int>(a.size())));
+      on, mean_of(a), "<=", 25.0, "deg", static_cast<int>(a.size()));
+  set_prediction(&c, mean_of(ap), static_cast<int>(ap.size()), 5.0,
+                 std::string("mean angle of ") + kStaticNote);
+  claims->push_back(c);
 }
 
 // Cases 3 and 4: position (3) or orientation (4) weighs more than in case 2,
 // the same readings through case 2's gains.
 void weighting_claim(int thesis_case, const std::vector<TraceRow>& rows,
-                     const HandScript& script, std::vector<Claim>* claims) {
+                     const HandScript& script, const Predictions& pred,
+                     std::vector<Claim>* claims) {
+  const ControllerParams& p = pred.params();
+  const std::optional<ControllerParams> ref = reference_params(thesis_case, p);
   const std::set<std::string> off_mis = {"off_out_misaligned"};
   const auto w = settled(rows, script, off_mis);
-  std::vector<double> mine, ref;
+  std::vector<double> mine, theirs, mine_p, theirs_p;
   for (const TraceRow* r : w) {
     const Vec3 dv = r->out.x_v_mm - r->out.p_rm_mm;
     const double a = angle_deg(r->out.force_device_N, dv);
     const double b = angle_deg(r->force_reference_N, dv);
     if (std::isfinite(a) && std::isfinite(b)) {
       mine.push_back(a);
-      ref.push_back(b);
+      theirs.push_back(b);
+    }
+    const LawPrediction& lp = pred.at(r);
+    if (!lp.available || !ref) continue;
+    const LawPrediction lr = Predictions::predict(*r, *ref);
+    if (!lr.available) continue;
+    const Vec3 dv_p = lp.x_v_mm - Predictions::p_true_mm(*r, p);
+    const double ap = angle_deg(lp.force_limited_N, dv_p);
+    const double bp = angle_deg(lr.force_limited_N, dv_p);
+    if (std::isfinite(ap) && std::isfinite(bp)) {
+      mine_p.push_back(ap);
+      theirs_p.push_back(bp);
     }
   }
-  const double ratio = mean_of(mine) / mean_of(ref);
+  const double ratio = mean_of(mine) / mean_of(theirs);
+  const double ratio_p = mean_of(mine_p) / mean_of(theirs_p);
+  const std::string note = std::string("the same ratio by ") + kStaticNote +
+                           ", with this case's gains and case 2's";
   if (thesis_case == 3) {
-    claims->push_back(make(
+    Claim c = make(
         "position_weighs_more_than_case2",
         "position error weighs more than in case 2: the force's angle from "
         "X(theta_V) over case 2's at the same readings",
-        off_mis, ratio, "<=", 0.95, "-", static_cast<int>(mine.size())));
+        off_mis, ratio, "<=", 0.95, "-", static_cast<int>(mine.size()));
+    set_prediction(&c, ratio_p, static_cast<int>(mine_p.size()),
+                   std::max(0.02, 0.1 * std::abs(ratio_p)), note);
+    claims->push_back(c);
   } else {
-    claims->push_back(make(
+    Claim c = make(
         "orientation_weighs_more_than_case2",
         "orientation error weighs more than in case 2: the force's angle "
         "from X(theta_V) over case 2's at the same readings",
-        off_mis, ratio, ">=", 1.05, "-", static_cast<int>(mine.size())));
+        off_mis, ratio, ">=", 1.05, "-", static_cast<int>(mine.size()));
+    set_prediction(&c, ratio_p, static_cast<int>(mine_p.size()),
+                   std::max(0.02, 0.1 * std::abs(ratio_p)), note);
+    claims->push_back(c);
   }
 }
 
 // Case 4 (Fig. 4.12): farther from the path the force is much greater than
 // on it.
 void force_grows_claim(const std::vector<TraceRow>& rows,
-                       const HandScript& script, std::vector<Claim>* claims) {
+                       const HandScript& script, const Predictions& pred,
+                       std::vector<Claim>* claims) {
   const std::set<std::string> sweep = {"sweep"};
-  std::vector<double> far, near;
+  std::vector<double> far, near, far_p, near_p;
   for (const TraceRow& r : rows) {
     if (script.segments()[static_cast<std::size_t>(r.segment)].name != "sweep")
       continue;
     const double f = r.out.force_device_N.norm();
-    if (r.d_path_mm >= 5.0) far.push_back(f);
-    if (r.d_path_mm <= kOnPathMm) near.push_back(f);
+    const LawPrediction& lp = pred.at(&r);
+    if (r.d_path_mm >= 5.0) {
+      far.push_back(f);
+      if (lp.available) far_p.push_back(lp.force_limited_N.norm());
+    }
+    if (r.d_path_mm <= kOnPathMm) {
+      near.push_back(f);
+      if (lp.available) near_p.push_back(lp.force_limited_N.norm());
+    }
   }
-  claims->push_back(make(
+  Claim c = make(
       "force_grows_off_path",
       "farther from the path the force is much greater than on it: mean "
       "|F| at >= 5 mm over mean |F| within 1 mm, during the sweep",
       sweep, mean_of(far) / std::max(mean_of(near), 1e-9), ">=", 3.0, "-",
-      static_cast<int>(std::min(far.size(), near.size()))));
+      static_cast<int>(std::min(far.size(), near.size())));
+  const double ratio_p = mean_of(far_p) / std::max(mean_of(near_p), 1e-9);
+  set_prediction(&c, ratio_p,
+                 static_cast<int>(std::min(far_p.size(), near_p.size())),
+                 0.15 * std::abs(ratio_p),
+                 std::string("the same ratio by ") + kStaticNote);
+  claims->push_back(c);
 }
 
 std::vector<Claim> measure_claims(int thesis_case,
                                   const std::vector<TraceRow>& rows,
-                                  const ClosedLoop& loop) {
+                                  const ClosedLoop& loop,
+                                  const Predictions& pred) {
   std::vector<Claim> claims;
   if (thesis_case < 1 || thesis_case > 6) return claims;
   const HandScript& script = loop.script();
   const ControllerParams& p = loop.controller_params();
   if (!(p.gains.k_ornt_Nmm_per_rad > 0.0)) {  // cases 1 and 5
-    position_claims(rows, script, p, &claims);
+    position_claims(rows, script, pred, &claims);
     return claims;
   }
-  orientation_claims(rows, script, &claims);
-  if (p.vm.kind == VmKind::kCircle) along_path_claim(rows, script, p, &claims);
+  orientation_claims(rows, script, pred, &claims);
+  if (p.vm.kind == VmKind::kCircle) along_path_claim(rows, script, pred, &claims);
   if (thesis_case == 3 || thesis_case == 4) {
-    weighting_claim(thesis_case, rows, script, &claims);
+    weighting_claim(thesis_case, rows, script, pred, &claims);
   }
-  if (thesis_case == 4) force_grows_claim(rows, script, &claims);
+  if (thesis_case == 4) force_grows_claim(rows, script, pred, &claims);
   return claims;
 }
 

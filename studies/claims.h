@@ -29,7 +29,45 @@ struct Claim {
   // "off the path" depend on how far off (docs/testbed.md)
   double mean_path_distance_mm = 0.0;
   bool pass = false;
+  // The same measure on the force the law gives at the window's ground-
+  // truth poses, limits included (studies/law_prediction.h), and whether
+  // the measured value is within `tolerance` of it (in the claim's unit).
+  // No prediction where the law has no closed form there; `prediction_note`
+  // says how it is computed or why there is none.
+  std::optional<double> prediction;
+  double tolerance = 0.0;
+  std::optional<bool> matches_prediction;
+  std::string prediction_note;
+  // the window's ticks whose force or torque was limited, and the regime
+  // they make: "saturated" when at least half were, else "linear"
+  double saturated_fraction = 0.0;
+  std::string regime = "linear";
+  // The sides of the pivot the case was run on (run_case runs it again
+  // with the start pose mirrored left to right, so that no claim passes by
+  // the side it was tried on), each with its own figures. `value`,
+  // `prediction` and the rest above are the first side's; `pass` holds
+  // only if the claim holds on every side, and `partial` if on some, with
+  // `holds_where` naming them. Empty when only one side was run.
+  struct Side {
+    std::string where;
+    double value = 0.0;
+    bool pass = false;
+    std::optional<double> prediction;
+    std::optional<bool> matches_prediction;
+    std::string regime;
+    double mean_path_distance_mm = 0.0;
+  };
+  std::vector<Side> sides;
+  bool partial = false;
+  std::string holds_where;
 };
+
+// Joins the claims of the same case run on two sides (first: the claims of
+// the run as given, labelled where_first; second: the mirrored run's, in
+// the same order) into first: sides, pass, partial, holds_where.
+void merge_sides(std::vector<Claim>* first, const std::string& where_first,
+                 const std::vector<Claim>& second,
+                 const std::string& where_second);
 
 struct RunMetrics {
   int ticks = 0;

@@ -90,6 +90,7 @@ const char* const kStyle =
     "table{border-collapse:collapse;margin:0.5em 0;font-size:0.9em}"
     "td,th{border:1px solid #ccc;padding:2px 6px;text-align:left}"
     "th{background:#f2f2f2}td.pass{background:#e6f4e6}"
+    "td.partial{background:#fdf1cf;color:#750}"
     "td.fail,tr.fail td{background:#fbd9d9;font-weight:bold;color:#900}"
     "span.fail{color:#900;font-weight:bold}span.pass{color:#060}"
     ".note{color:#775;font-style:italic}.scroll{overflow-x:auto}"
@@ -127,15 +128,26 @@ std::string parameters(const Json& summary) {
 std::string claims_table(const Json& summary) {
   std::string s = "<table class=\"claims\">\n<tr>" + th("claim") +
                   th("value") + th("comparison") + th("threshold") +
-                  th("unit") + th("pass") + th("window") +
+                  th("unit") + th("pass") + th("prediction (law)") +
+                  th("regime") + th("window") +
                   th("mean distance off the path (mm)") + th("statement") +
                   "</tr>\n";
   for (const Json& c : at(summary, "claims")) {
-    const bool pass = at(c, "pass").is_boolean() && at(c, "pass").get<bool>();
-    s += std::string(pass ? "<tr class=\"pass\">" : "<tr class=\"fail\">") +
+    const Json& verdict = at(c, "pass");
+    const bool pass = verdict.is_boolean() && verdict.get<bool>();
+    const bool partial = verdict.is_string() && verdict.get<std::string>() == "partial";
+    std::string verdict_text = pass ? "pass" : "FAIL";
+    if (partial) verdict_text = "partial: holds " + num(at(c, "holds_where"));
+    std::string prediction = num(at(c, "prediction"));
+    if (c.contains("matches_prediction") && c["matches_prediction"].is_boolean()) {
+      prediction += c["matches_prediction"].get<bool>() ? " (agrees)" : " (differs)";
+    }
+    s += std::string(pass || partial ? "<tr>" : "<tr class=\"fail\">") +
          td(num(at(c, "name"))) + td(num(at(c, "value"))) +
          td(num(at(c, "comparison"))) + td(num(at(c, "threshold"))) +
-         td(num(at(c, "unit"))) + td(pass ? "pass" : "FAIL", pass ? "pass" : "fail") +
+         td(num(at(c, "unit"))) +
+         td(verdict_text, pass ? "pass" : partial ? "partial" : "fail") +
+         td(prediction) + td(num(at(c, "regime"))) +
          td(num(at(c, "window"))) + td(num(at(c, "mean_path_distance_mm"))) +
          td(num(at(c, "statement"))) + "</tr>\n";
   }
@@ -185,12 +197,13 @@ std::string run_time_table(const std::vector<ReportCase>& cases) {
                   th("claims passed") + "</tr>\n";
   for (const ReportCase& c : cases) {
     const Json& m = at(c.summary, "metrics");
-    int pass = 0, total = 0;
+    int pass = 0, total = 0, failed = 0;
     for (const Json& k : at(c.summary, "claims")) {
       ++total;
       pass += at(k, "pass").is_boolean() && at(k, "pass").get<bool>() ? 1 : 0;
+      failed += at(k, "pass").is_boolean() && !at(k, "pass").get<bool>() ? 1 : 0;
     }
-    s += std::string(pass == total ? "<tr>" : "<tr class=\"fail\">") +
+    s += std::string(failed == 0 ? "<tr>" : "<tr class=\"fail\">") +
          td(c.name) + td(num(at(c.summary, "simulated_s"))) +
          td(num(at(c.summary, "wall_time_s"))) +
          td(num(at(c.summary, "realtime_factor"))) +
@@ -284,8 +297,11 @@ ClaimTally tally_claims(const std::vector<ReportCase>& cases) {
   for (const ReportCase& c : cases) {
     for (const Json& k : at(c.summary, "claims")) {
       ++t.total;
-      if (at(k, "pass").is_boolean() && at(k, "pass").get<bool>()) {
+      const Json& v = at(k, "pass");
+      if (v.is_boolean() && v.get<bool>()) {
         ++t.passed;
+      } else if (v.is_string() && v.get<std::string>() == "partial") {
+        t.partial.push_back(c.name + ":" + num(at(k, "name")));
       } else {
         t.failed.push_back(c.name + ":" + num(at(k, "name")));
       }
@@ -326,7 +342,7 @@ std::string inline_svg(const std::string& svg_document) {
 std::string report_html(const ReportInputs& in) {
   const ReportHeader& h = in.header;
   const ClaimTally tally = tally_claims(in.cases);
-  const bool all_pass = tally.passed == tally.total;
+  const bool all_pass = tally.failed.empty();
   std::string s =
       "<!DOCTYPE html>\n<html xmlns=\"http://www.w3.org/1999/xhtml\" "
       "lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n"
@@ -351,6 +367,10 @@ std::string report_html(const ReportInputs& in) {
        (all_pass ? std::string()
                  : " &#8212; failing: <span class=\"fail\">" +
                        escape(list_text(tally.failed)) + "</span>") +
+       (tally.partial.empty()
+            ? std::string()
+            : " &#8212; holding on one side of the pivot only: " +
+                  escape(list_text(tally.partial))) +
        "</p>\n";
   s += "<ul>\n";
   for (const ReportCase& c : in.cases) {

@@ -77,6 +77,9 @@ struct ClaimTally {
   int passed = 0;
   int total = 0;
   std::vector<std::string> failed;  // "case:claim"
+  // held on some sides of the pivot only ("pass": "partial"), "case:claim";
+  // counted in total, neither passed nor failed
+  std::vector<std::string> partial;
 };
 ClaimTally tally_claims(const std::vector<ReportCase>& cases);
 

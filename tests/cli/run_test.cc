@@ -65,12 +65,20 @@ TEST(RunCli, WritesTraceAndSummary) {
   EXPECT_EQ(s.at("parameters").at("vm_kind").at("value"), "circle");
   EXPECT_EQ(s.at("parameters").at("hand_k_pos_N_per_m").at("source"), "scene");
   EXPECT_EQ(s.at("mujoco_warnings"), 0);
-  ASSERT_EQ(s.at("claims").size(), 3u);
+  ASSERT_EQ(s.at("claims").size(), 2u);
   for (const auto& c : s.at("claims")) {
     for (const char* k : {"name", "value", "threshold", "comparison", "unit",
-                          "samples", "pass"}) {
+                          "samples", "pass", "prediction", "tolerance",
+                          "matches_prediction", "prediction_note",
+                          "saturated_fraction", "regime", "holds_where",
+                          "sides"}) {
       EXPECT_TRUE(c.contains(k)) << k;
     }
+    const std::string regime = c.at("regime");
+    EXPECT_TRUE(regime == "linear" || regime == "saturated") << regime;
+    // both sides of the pivot
+    ASSERT_EQ(c.at("sides").size(), 2u) << c.dump();
+    EXPECT_NE(c.at("sides")[0].at("where"), c.at("sides")[1].at("where"));
   }
 }
 

@@ -170,7 +170,7 @@ TEST(ReportHtmlTest, RealRunsOfTheSixCasesAreAllOnThePage) {
   }
   const std::string html = report_html(in);
   EXPECT_EQ(check_page(html), 0);  // no renderer: no image
-  int total = 0, passed = 0;
+  int total = 0, passed = 0, failed = 0;
   for (const CaseJob& j : jobs) {
     EXPECT_NE(html.find("<section id=\"" + j.name + "\">"), std::string::npos) << j.name;
     const nlohmann::json summary = nlohmann::json::parse(
@@ -179,12 +179,13 @@ TEST(ReportHtmlTest, RealRunsOfTheSixCasesAreAllOnThePage) {
       const std::string name = c.at("name");
       EXPECT_NE(html.find("<td>" + name + "</td>"), std::string::npos) << name;
       ++total;
-      passed += c.at("pass").get<bool>() ? 1 : 0;
+      passed += c.at("pass") == true ? 1 : 0;
+      failed += c.at("pass") == false ? 1 : 0;
     }
   }
   EXPECT_GT(total, 0);
   EXPECT_NE(html.find("Claims passed: <span class=\"" +
-                      std::string(passed == total ? "pass" : "fail") + "\">" +
+                      std::string(failed == 0 ? "pass" : "fail") + "\">" +
                       std::to_string(passed) + "/" + std::to_string(total)),
             std::string::npos);
   EXPECT_EQ(testing::count(html, "render unavailable: no renderer in this build"), 6u);
