@@ -46,6 +46,7 @@ struct Row : ParamSpec {
   Row& flag01() { return whole_in(0, 1); }
   Row& infinite_ok() { allow_inf = true; return *this; }
   Row& note(const char* n) { range_note = n; return *this; }
+  Row& source(const char* r) { reference = r; return *this; }
   Row& on_surface(const char* d) { surface_default = d; return *this; }
   Row& ctl(const char* option) { ctl_option = option; return *this; }
   Row& ctl_default_is(const char* d) { ctl_default = d; return *this; }
@@ -222,7 +223,8 @@ const std::vector<ParamSpec>& case_fields() {
            [](CaseParams* p, const ParamValue& v) {
              p->controller.torque_limits = parse_torque_limits(v.text);
            })
-          .ctl("--torque-limits"),
+          .ctl("--torque-limits")
+          .source("the OpenHaptics samples' clamps; rated: the 3.3 N peak at the nominal pose (docs/safety.md; docs/sources.md, 7)"),
 
       // ---- the simulator ----
       numeric("sim", "physics_step_s", 1, "0", "s",
@@ -376,37 +378,43 @@ const std::vector<ParamSpec>& case_fields() {
               [](CaseParams* p, const ParamValue& v) {
                 p->hand.mass_kg = item(v);
               })
-          .positive(),
+          .positive()
+          .source("van Beek et al. (2015), the fit of one trial of a whole-arm grasp (docs/sources.md, 10); a stylus in a pen grip: 0.20-0.27 kg, 0.14-0.57 over 95% of 15 subjects and 1-3 N grips (Fu & Cavusoglu 2012, at second hand; docs/sources.md, 10.1)"),
       numeric("hand", "hand_inertia_kgm2", 3, "2e-4 2e-4 2e-4", "kg m^2",
               "hand rotational inertia about the grip, stylus axes",
               [](CaseParams* p, const ParamValue& v) {
                 p->hand.inertia_kgm2 = vec3(v);
               })
-          .positive(),
+          .positive()
+          .source("estimate (models/hand/README.md); no pen-grip measurement found (docs/sources.md, 10.1)"),
       numeric("hand", "hand_k_pos_N_per_m", 1, "135", "N/m",
               "hand translational stiffness (van Beek et al. 2015)",
               [](CaseParams* p, const ParamValue& v) {
                 p->hand.k_pos_N_per_m = item(v);
               })
-          .non_negative(),
+          .non_negative()
+          .source("van Beek et al. (2015), one trial (docs/sources.md, 10); a pen grip reduced to one stage: 65, 88, 201 N/m along x, y, z, 49-353 over the 95% intervals (Fu & Cavusoglu 2012, at second hand; docs/sources.md, 10.1)"),
       numeric("hand", "hand_b_pos_Ns_per_m", 1, "6.45", "N s/m",
               "hand translational damping (van Beek et al. 2015)",
               [](CaseParams* p, const ParamValue& v) {
                 p->hand.b_pos_Ns_per_m = item(v);
               })
-          .non_negative(),
+          .non_negative()
+          .source("van Beek et al. (2015), one trial (docs/sources.md, 10); a pen grip: 3.2, 4.6, 9.9 N s/m along x, y, z, about 2.5-16 (Fu & Cavusoglu 2012); 12.6-15.8 along a pen-held stylus (Israr, Choi & Tan 2006) (docs/sources.md, 10.1)"),
       numeric("hand", "hand_k_rot_Nm_per_rad", 1, "0.5", "N m/rad",
               "hand rotational stiffness (estimate, models/hand/README.md)",
               [](CaseParams* p, const ParamValue& v) {
                 p->hand.k_rot_Nm_per_rad = item(v);
               })
-          .non_negative(),
+          .non_negative()
+          .source("estimate (models/hand/README.md); derived, not measured: a pen grip's roll 0.075-0.16 and tilt 0.4-0.6 N m/rad, a relaxed wrist 1.2-1.8 (Formica et al. 2012) (docs/sources.md, 10.1)"),
       numeric("hand", "hand_b_rot_Nms_per_rad", 1, "0.02", "N m s/rad",
               "hand rotational damping (estimate, models/hand/README.md)",
               [](CaseParams* p, const ParamValue& v) {
                 p->hand.b_rot_Nms_per_rad = item(v);
               })
-          .non_negative(),
+          .non_negative()
+          .source("estimate (models/hand/README.md); no measured rotational damping of a pen grip found (docs/sources.md, 10.1)"),
   };
   return fields;
 }

@@ -348,6 +348,13 @@ const ParamSpec* param_of_validate_message(const std::string& message) {
 
 namespace {
 
+// the meaning, and where its default comes from
+std::string meaning(const ParamSpec& f) {
+  std::string m = f.doc;
+  if (f.reference != nullptr) m += ". Default from: " + std::string(f.reference);
+  return m;
+}
+
 std::string cell(const std::string& s) {
   std::string out;
   for (char ch : s) {
@@ -397,7 +404,8 @@ std::string parameters_markdown() {
         "not finite (`friction_mu` may be `inf`) or out of range is refused "
         "when the case is loaded, naming the file (or `--set`, or the ctl "
         "option) and the field. summary.json lists every parameter with its "
-        "value, unit and source (`default`, `scene` or `set`).\n"
+        "value, unit and source (`default`, `scene` or `set`), and, where "
+        "the table has one, the `reference` its default comes from.\n"
         "\n"
         "Frames: positions and directions are in the device frame (Omni "
         "origin, mm) unless named. Velocity damping: `k_vel_Ns_per_mm` acts "
@@ -425,7 +433,7 @@ std::string parameters_markdown() {
       }
       md << "| `" << f.name << "` | " << ctl << " | " << type_text(f) << " | "
          << cell(f.unit) << " | " << cell(f.default_text()) << " | "
-         << cell(f.range_text()) << " | " << cell(f.doc) << " |\n";
+         << cell(f.range_text()) << " | " << cell(meaning(f)) << " |\n";
     }
   }
   return md.str();

@@ -153,6 +153,10 @@ struct ParamSpec {
   bool allow_inf = false;      // +inf is a valid value
   const char* words = nullptr; // text: the valid values, ", "-separated
   const char* range_note = nullptr;  // a rule beyond `rule`, for the docs
+  // where the default comes from (a publication and its section of
+  // docs/sources.md, or "estimate"), with the published spread where there
+  // is one; summary.json and docs/parameters.md carry it
+  const char* reference = nullptr;
   // the default when vm_kind is surface, if different
   const char* surface_default = nullptr;
   // `vmhaptics ctl`: the option (nullptr: none), its default if the

@@ -119,7 +119,10 @@ std::string parameters(const Json& summary) {
        td("s") + td("scene") + "</tr>\n</table>\n";
   if (params.is_object()) {
     s += "<details><summary>every parameter</summary>\n<table class=\"params\">\n";
-    for (auto it = params.begin(); it != params.end(); ++it) s += row(it.key(), *it);
+    // (parameters.hand repeats the hand's rows as a group: not a row itself)
+    for (auto it = params.begin(); it != params.end(); ++it) {
+      if (it->is_object() && it->contains("value")) s += row(it.key(), *it);
+    }
     s += "</table></details>\n";
   }
   return s;

@@ -277,6 +277,9 @@ CaseResult run_case(const std::string& name, const std::string& scene,
     params[f.name] = {{"value", v},
                       {"unit", f.unit},
                       {"source", value_source_name(given.source)}};
+    if (f.reference != nullptr) params[f.name]["reference"] = f.reference;
+    // the hand's values together as well, each with where it comes from
+    if (std::strcmp(f.group, "hand") == 0) params["hand"][f.name] = params[f.name];
   }
   nlohmann::json warnings = nlohmann::json::object();
   int warning_total = 0;

@@ -64,6 +64,15 @@ TEST(RunCli, WritesTraceAndSummary) {
   EXPECT_EQ(s.at("parameters").at("duration_s").at("source"), "set");
   EXPECT_EQ(s.at("parameters").at("vm_kind").at("value"), "circle");
   EXPECT_EQ(s.at("parameters").at("hand_k_pos_N_per_m").at("source"), "scene");
+  // the hand's values, together, each with where its default comes from
+  const auto& hand = s.at("parameters").at("hand");
+  EXPECT_EQ(hand.size(), 6u);
+  for (const auto& [name, v] : hand.items()) {
+    EXPECT_EQ(name.rfind("hand_", 0), 0u) << name;
+    ASSERT_TRUE(v.contains("reference")) << name;
+    const std::string ref = v.at("reference");
+    EXPECT_NE(ref.find("docs/sources.md"), std::string::npos) << name << ": " << ref;
+  }
   EXPECT_EQ(s.at("mujoco_warnings"), 0);
   ASSERT_EQ(s.at("claims").size(), 2u);
   for (const auto& c : s.at("claims")) {
