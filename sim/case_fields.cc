@@ -292,6 +292,15 @@ const std::vector<ParamSpec>& case_fields() {
                 p->script.off_mm = item(v);
               })
           .non_negative(),
+      numeric("script", "script_near_off_mm", 1, "15", "mm",
+              "run_case runs the case once more with the off-path holds this "
+              "far off the path, where the law's force stays under the "
+              "limits (the RM settles 1-3 mm off), to try the off-path "
+              "claims in the linear regime; 0: no such run",
+              [](CaseParams* p, const ParamValue& v) {
+                p->script.near_off_mm = item(v);
+              })
+          .non_negative(),
       numeric("script", "script_misalign_rad", 1, "0.5", "rad",
               "stylus misalignment on the path",
               [](CaseParams* p, const ParamValue& v) {

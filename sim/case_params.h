@@ -98,6 +98,9 @@ struct ScriptSettings {
   Vec3 dir = Vec3::Zero();
   Vec3 axis = Vec3::Zero();  // 0 0 0: along dir
   double off_mm{};
+  // run_case's run near the path, for the off-path claims in the linear
+  // regime: the hand target this far off (mm); 0: no such run
+  double near_off_mm{};
   double misalign_rad{};
   double sweep_mm{};
   double sweep_rad{};

@@ -120,9 +120,8 @@ RunMetrics run_metrics(const std::vector<TraceRow>& rows,
   return m;
 }
 
-void merge_sides(std::vector<Claim>* first, const std::string& where_first,
-                 const std::vector<Claim>& second,
-                 const std::string& where_second) {
+void merge_sides(std::vector<Claim>* first, const SideRun& where_first,
+                 const std::vector<SideRun>& others) {
   const auto side = [](const Claim& c, const std::string& where) {
     Claim::Side s;
     s.where = where;
@@ -135,11 +134,18 @@ void merge_sides(std::vector<Claim>* first, const std::string& where_first,
     return s;
   };
   for (Claim& c : *first) {
-    const auto other =
-        std::find_if(second.begin(), second.end(),
-                     [&](const Claim& o) { return o.name == c.name; });
-    c.sides = {side(c, where_first)};
-    if (other != second.end()) c.sides.push_back(side(*other, where_second));
+    const bool off_path = c.window.find("off_") != std::string::npos;
+    const auto label = [&](const SideRun& r) {
+      return off_path ? r.where_off_path : r.where;
+    };
+    c.sides = {side(c, label(where_first))};
+    for (const SideRun& run : others) {
+      if (run.off_path_only && !off_path) continue;
+      const auto other =
+          std::find_if(run.claims.begin(), run.claims.end(),
+                       [&](const Claim& o) { return o.name == c.name; });
+      if (other != run.claims.end()) c.sides.push_back(side(*other, label(run)));
+    }
     int held = 0;
     std::string where;
     for (const Claim::Side& s : c.sides) {

@@ -62,12 +62,23 @@ struct Claim {
   std::string holds_where;
 };
 
-// Joins the claims of the same case run on two sides (first: the claims of
-// the run as given, labelled where_first; second: the mirrored run's, in
-// the same order) into first: sides, pass, partial, holds_where.
-void merge_sides(std::vector<Claim>* first, const std::string& where_first,
-                 const std::vector<Claim>& second,
-                 const std::string& where_second);
+// The claims of one more run of the same case (the script mirrored, or
+// held nearer the path), as a side of each claim in `first`.
+struct SideRun {
+  std::string where;           // the side, for every claim
+  std::string where_off_path;  // the same for the off-path claims
+  std::vector<Claim> claims;
+  // the run only changes the off-path holds: it is a side of the claims
+  // measured over them (windows off_out, off_out_misaligned, off_in) only
+  bool off_path_only = false;
+};
+
+// Makes `first` (the claims of the run as given, labelled by where_first's
+// labels; its claims are not read) and
+// the claims of `others` (matched by name) sides of each claim, and sets
+// pass, partial and holds_where from them.
+void merge_sides(std::vector<Claim>* first, const SideRun& where_first,
+                 const std::vector<SideRun>& others);
 
 struct RunMetrics {
   int ticks = 0;

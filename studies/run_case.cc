@@ -207,11 +207,6 @@ std::vector<double> field_numbers(const ClosedLoop& loop, const char* name) {
   return {};
 }
 
-// where the script starts, for a side's label
-std::string side_label(double x) {
-  return x < 0.0 ? "left of the pivot (script_dir x < 0, device frame)"
-                 : "right of the pivot (script_dir x > 0, device frame)";
-}
 
 }  // namespace
 
@@ -234,25 +229,56 @@ CaseResult run_case(const std::string& name, const std::string& scene,
   result.metrics = run_metrics(rows, loop);
   result.claims = evaluate_claims(thesis_case, rows, loop);
   // the same script mirrored left to right (script_dir's and script_axis's
-  // x negated): a claim that holds on one side only is partial
+  // x negated), and held near the path (script_near_off_mm): a claim that
+  // holds on some of these only is partial
   const std::vector<double> start_dir = field_numbers(loop, "script_dir");
-  if (!result.claims.empty() && start_dir.size() == 3 && std::abs(start_dir[0]) > 1e-9) {
-    std::vector<std::string> mirrored = overrides;
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "script_dir=%.17g,%.17g,%.17g", -start_dir[0],
-                  start_dir[1], start_dir[2]);
-    mirrored.emplace_back(buf);
-    const std::vector<double> axis = field_numbers(loop, "script_axis");
-    if (axis.size() == 3 && (axis[0] != 0.0 || axis[1] != 0.0 || axis[2] != 0.0)) {
-      std::snprintf(buf, sizeof buf, "script_axis=%.17g,%.17g,%.17g", -axis[0],
-                    axis[1], axis[2]);
-      mirrored.emplace_back(buf);
+  const std::vector<double> off = field_numbers(loop, "script_off_mm");
+  const std::vector<double> near = field_numbers(loop, "script_near_off_mm");
+  if (!result.claims.empty() && start_dir.size() == 3 && off.size() == 1 &&
+      near.size() == 1) {
+    const auto run_with = [&](std::vector<std::string> extra) {
+      std::vector<std::string> o = overrides;
+      o.insert(o.end(), extra.begin(), extra.end());
+      ClosedLoop l(scene, o, omni_model_hook(model_file));
+      const std::vector<TraceRow> r = run_to_end(&l);
+      return evaluate_claims(thesis_case, r, l);
+    };
+    const auto number = [](const char* field, double v) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s=%.17g", field, v);
+      return std::string(buf);
+    };
+    const auto side = [](double x, double off_mm, const char* more) {
+      SideRun r;
+      r.where = x < 0.0 ? "left of the pivot" : "right of the pivot";
+      char buf[96];
+      std::snprintf(buf, sizeof buf, ", off-path holds %g mm out%s", off_mm, more);
+      r.where_off_path = r.where + buf;
+      return r;
+    };
+    std::vector<SideRun> others;
+    if (std::abs(start_dir[0]) > 1e-9) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "script_dir=%.17g,%.17g,%.17g",
+                    -start_dir[0], start_dir[1], start_dir[2]);
+      std::vector<std::string> mirrored = {buf};
+      const std::vector<double> axis = field_numbers(loop, "script_axis");
+      if (axis.size() == 3 && (axis[0] != 0.0 || axis[1] != 0.0 || axis[2] != 0.0)) {
+        std::snprintf(buf, sizeof buf, "script_axis=%.17g,%.17g,%.17g",
+                      -axis[0], axis[1], axis[2]);
+        mirrored.emplace_back(buf);
+      }
+      SideRun r = side(-start_dir[0], off[0], "");
+      r.claims = run_with(mirrored);
+      others.push_back(r);
     }
-    ClosedLoop other(scene, mirrored, omni_model_hook(model_file));
-    const std::vector<TraceRow> other_rows = run_to_end(&other);
-    merge_sides(&result.claims, side_label(start_dir[0]),
-                evaluate_claims(thesis_case, other_rows, other),
-                side_label(-start_dir[0]));
+    if (near[0] > 0.0 && near[0] != off[0]) {
+      SideRun r = side(start_dir[0], near[0], " (near the path)");
+      r.claims = run_with({number("script_off_mm", near[0])});
+      r.off_path_only = true;
+      others.push_back(r);
+    }
+    merge_sides(&result.claims, side(start_dir[0], off[0], ""), others);
   }
   // a claim that holds on one side only is reported, not failed
   for (const Claim& c : result.claims) {

@@ -85,8 +85,8 @@ TEST(RunCli, WritesTraceAndSummary) {
     }
     const std::string regime = c.at("regime");
     EXPECT_TRUE(regime == "linear" || regime == "saturated") << regime;
-    // both sides of the pivot
-    ASSERT_EQ(c.at("sides").size(), 2u) << c.dump();
+    // both sides of the pivot (and near the path for an off-path claim)
+    ASSERT_GE(c.at("sides").size(), 2u) << c.dump();
     EXPECT_NE(c.at("sides")[0].at("where"), c.at("sides")[1].at("where"));
   }
 }
