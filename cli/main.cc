@@ -91,6 +91,9 @@ int main(int argc, char** argv) {
   vmh::cli::register_view(&app);
 #endif
 
+  // CLI11 reads an empty value of a numeric option as 0: refuse it instead
+  vmh::cli::refuse_empty_numbers(&app);
+
   try {
     check_verbs(&app, argc, argv);
     app.parse(argc, argv);

@@ -505,6 +505,13 @@ TEST(CtlErrors, AnOverflowingForceIsANumericalFault) {
   EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;
 }
 
+// strtod's ERANGE for a subnormal result is no reason to refuse it
+TEST(CtlOptions, SubnormalNumbersAreNumbers) {
+  const json j = ctl("--kpos 1e-320 --q 1e-320,0.1,0.2,0,0,0");
+  EXPECT_EQ(j["q_dh"][0].get<double>(), 1e-320);
+  EXPECT_EQ(j["gains"]["k_pos_N_per_mm"].get<double>(), 1e-320);
+}
+
 TEST(CtlHelp, TopLevelHelpListsCtl) {
   const CliRun r = run("--help");
   EXPECT_EQ(r.exit_code, 0);
