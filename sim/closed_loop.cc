@@ -5,6 +5,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "sim/case_params_detail.h"
 
 namespace vmh::sim {
 namespace {
@@ -21,6 +22,9 @@ std::uint64_t next_random(std::uint64_t* state) {
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
   return z ^ (z >> 31);
 }
+
+// a number in a message: %g-style, 9 significant digits (1e-07, 0.001)
+std::string num(double v) { return detail::format_number(v); }
 
 bool all_finite(const mjtNum* v, int n) {
   for (int i = 0; i < n; ++i) {
@@ -80,17 +84,42 @@ void ClosedLoop::apply_model_options() {
 }
 
 void ClosedLoop::setup_timing() {
+  // every count below is computed in double, checked against its bound and
+  // only then made an integer; the table's ranges (sim/case_fields.cc)
+  // have already refused non-finite values, T outside [1e-5, 1] s and a
+  // duration outside (0, 3600] s
   const double T = config_.controller.servo_period_s;
   const double h = model_->opt.timestep;
+  const std::string step_name =
+      config_.sim.physics_step_s > 0.0 ? "physics_step_s"
+                                       : "the scene's <option timestep>";
+  if (!std::isfinite(h) || !(h > 0.0)) {
+    throw SimError(path_ + ": " + step_name + " must be finite and > 0, got " +
+                   num(h) + " s");
+  }
   const double n = std::round(T / h);
-  if (n < 1.0 || std::abs(n * h - T) > 1e-9 * T) {
-    throw SimError(path_ + ": servo_period_s (" + std::to_string(T) +
+  if (!(n >= 1.0 && n <= static_cast<double>(kMaxSubstepsPerTick))) {
+    throw SimError(path_ + ": servo_period_s / " + step_name + " (" + num(T) +
+                   " s / " + num(h) + " s) must be a whole number of physics "
+                   "steps in [1, " + std::to_string(kMaxSubstepsPerTick) +
+                   "], got " + num(T / h));
+  }
+  if (std::abs(n * h - T) > 1e-9 * T) {
+    throw SimError(path_ + ": servo_period_s (" + num(T) +
                    " s) must be a whole multiple of the physics step (" +
-                   std::to_string(h) + " s)");
+                   num(h) + " s)");
   }
   substeps_ = static_cast<int>(n);
   duration_s_ = config_.sim.duration_s;
-  ticks_per_run_ = static_cast<int>(std::llround(duration_s_ / T));
+  const double ticks = std::round(duration_s_ / T);
+  if (!(ticks >= 1.0 && ticks <= static_cast<double>(kMaxTicksPerRun))) {
+    throw SimError(path_ + ": duration_s (" + num(duration_s_) +
+                   " s) must last from 1 to " +
+                   std::to_string(kMaxTicksPerRun) +
+                   " servo periods (servo_period_s = " + num(T) +
+                   " s), got " + num(duration_s_ / T));
+  }
+  ticks_per_run_ = static_cast<std::int64_t>(ticks);
   jitter_seed_ = config_.sim.jitter_seed;
   setup_jitter(h);
 }
@@ -101,23 +130,31 @@ void ClosedLoop::setup_jitter(double h) {
                               config_.sim.jitter_max_s};
   if (!(jitter_s[1] > 0.0)) return;
   jitter_ = true;
-  jitter_lo_ = static_cast<int>(std::lround(jitter_s[0] / h));
-  jitter_hi_ = static_cast<int>(std::lround(jitter_s[1] / h));
-  if (jitter_lo_ < 1) {
+  const double steps[2] = {std::round(jitter_s[0] / h),
+                           std::round(jitter_s[1] / h)};
+  if (steps[0] < 1.0) {
     throw SimError(path_ + ": servo_jitter_s's shortest period (" +
-                   std::to_string(jitter_s[0]) +
-                   " s) is less than one physics step (" + std::to_string(h) +
-                   " s)");
+                   num(jitter_s[0]) + " s) is less than one physics step (" +
+                   num(h) + " s)");
+  }
+  if (!(steps[1] <= static_cast<double>(kMaxSubstepsPerTick))) {
+    throw SimError(path_ + ": servo_jitter_s's longest period / the physics "
+                   "step (" + num(jitter_s[1]) + " s / " + num(h) +
+                   " s) must be at most " +
+                   std::to_string(kMaxSubstepsPerTick) +
+                   " physics steps, got " + num(jitter_s[1] / h));
   }
   // the periods are drawn in whole physics steps: ends that are not whole
   // steps would be moved without a word
   for (double end_s : jitter_s) {
     if (std::abs(std::round(end_s / h) * h - end_s) > 1e-9 * end_s) {
-      throw SimError(path_ + ": servo_jitter_s (" + std::to_string(end_s) +
+      throw SimError(path_ + ": servo_jitter_s (" + num(end_s) +
                      " s) must be a whole multiple of the physics step (" +
-                     std::to_string(h) + " s); set physics_step_s");
+                     num(h) + " s); set physics_step_s");
     }
   }
+  jitter_lo_ = static_cast<int>(steps[0]);
+  jitter_hi_ = static_cast<int>(steps[1]);
 }
 
 void ClosedLoop::build_controller() {
@@ -196,9 +233,8 @@ Joints ClosedLoop::start_pose() {
   }
   if (best < 0) {
     throw SimError(path_ + ": the script's start pose (" +
-                   std::to_string(start.p_mm.x()) + ", " +
-                   std::to_string(start.p_mm.y()) + ", " +
-                   std::to_string(start.p_mm.z()) +
+                   num(start.p_mm.x()) + ", " + num(start.p_mm.y()) + ", " +
+                   num(start.p_mm.z()) +
                    ") mm cannot be reached within the joint ranges; change "
                    "script_dir, vm_pivot_mm or vm_length_mm");
   }

@@ -120,7 +120,7 @@ class ClosedLoop {
   double time_s() const;
   // the run's length in ticks at the nominal period; with servo jitter the
   // count differs, so loop until finished()
-  int ticks_per_run() const { return ticks_per_run_; }
+  std::int64_t ticks_per_run() const { return ticks_per_run_; }
   // whether time_s() has reached duration_s
   bool finished() const;
   // physics steps per tick at the nominal period
@@ -202,15 +202,15 @@ class ClosedLoop {
   Joints q_start_dh_ = Joints::Zero();
   Mat3 R_start_base_ = Mat3::Identity();  // stylus frame at the start pose
   int substeps_ = 1;
-  int ticks_per_run_ = 0;
+  std::int64_t ticks_per_run_ = 0;
   double duration_s_ = 0.0;  // the script's, read once (the tick reads it)
-  long tick_count_ = 0;
+  std::int64_t tick_count_ = 0;
   // servo jitter: steps per tick drawn from [lo, hi]; the generator's state
   bool jitter_ = false;
   int jitter_lo_ = 1, jitter_hi_ = 1;
   std::uint64_t jitter_seed_ = 1;
   std::uint64_t rng_state_ = 1;
-  long substep_count_ = 0;  // physics steps since t = 0
+  std::int64_t substep_count_ = 0;  // physics steps since t = 0
   bool manual_hand_ = false;
   HandTargetState manual_target_;
   // passivity observer

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -302,6 +303,74 @@ TEST(ClosedLoopTest, ManualTargetPullsTheGrip) {
   EXPECT_NEAR((row.hand_target.p_mm - loop.script().at(row.t_s).p_mm).norm(),
               0.0, 1e-12);
   EXPECT_GT((loop.hand().target().p_m - target.p_m).norm(), 0.01);
+}
+
+// ---- the bounds on a run's counts, checked before any work (issue 17) ----
+
+constexpr auto npos = std::string::npos;
+
+// the message of the SimError that making case 1's loop throws; "" if none
+std::string refusal(const std::vector<std::string>& sets,
+                    const ModelHook& hook = {}) {
+  try {
+    ClosedLoop loop(scene(1), sets, hook);
+  } catch (const SimError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// T / h must fit kMaxSubstepsPerTick: 1e-3 s / 1e-300 s was an int cast of
+// 1e297 (undefined behaviour) before
+TEST(ClosedLoopBounds, RefusesTooManyPhysicsStepsPerTick) {
+  const std::string msg = refusal({"physics_step_s=1e-300"});
+  EXPECT_NE(msg.find("servo_period_s / physics_step_s (0.001 s / 1e-300 s)"),
+            npos) << msg;
+  EXPECT_NE(msg.find("[1, 1000000]"), npos) << msg;
+  EXPECT_NE(msg.find("got 1e+297"), npos) << msg;
+  EXPECT_EQ(refusal({"physics_step_s=1e-9"}), "");   // 1e6 steps: the bound
+  EXPECT_NE(refusal({"physics_step_s=5e-10"}), "");  // 2e6
+  // a step longer than the period
+  EXPECT_NE(refusal({"physics_step_s=0.003"}).find("[1, 1000000]"), npos);
+}
+
+// the scene's own step (physics_step_s 0 keeps it) must be finite and > 0:
+// timestep="0" made T / h infinite
+TEST(ClosedLoopBounds, RefusesASceneStepThatIsNotFiniteAndPositive) {
+  for (const double h : {0.0, -0.001, std::nan(""), HUGE_VAL}) {
+    const std::string msg =
+        refusal({}, [h](mjModel* m) { m->opt.timestep = h; });
+    EXPECT_NE(msg.find("the scene's <option timestep> must be finite and > 0"),
+              npos) << h << ": " << msg;
+  }
+}
+
+// the jitter's longest period in physics steps: 0.9 s at a 1e-7 s step is
+// 9e6 steps in one tick
+TEST(ClosedLoopBounds, RefusesAJitterPeriodOfTooManySteps) {
+  const std::string msg =
+      refusal({"physics_step_s=1e-7", "servo_jitter_s=0.0004,0.9"});
+  EXPECT_NE(msg.find("servo_jitter_s's longest period"), npos) << msg;
+  EXPECT_NE(msg.find("at most 1000000 physics steps, got 9000000"), npos) << msg;
+}
+
+// a run must last at least one servo tick, and says so with the value as
+// %g (1e-07, not 0.000000)
+TEST(ClosedLoopBounds, RefusesARunShorterThanOneTick) {
+  const std::string msg = refusal({"duration_s=1e-7"});
+  EXPECT_NE(msg.find("duration_s (1e-07 s) must last from 1 to 1000000000 "
+                     "servo periods (servo_period_s = 0.001 s), got 0.0001"),
+            npos) << msg;
+  EXPECT_EQ(refusal({"duration_s=0.0006"}), "");  // rounds to one tick
+}
+
+// the longest run the table allows at its shortest period: 3.6e8 ticks,
+// counted in 64 bits
+TEST(ClosedLoopBounds, CountsTheLongestRunInAWideType) {
+  ClosedLoop loop(scene(1), {"duration_s=3600", "servo_period_s=1e-5",
+                             "physics_step_s=1e-5"});
+  EXPECT_EQ(loop.ticks_per_run(), std::int64_t{360000000});
+  EXPECT_EQ(loop.substeps(), 1);
 }
 
 }  // namespace
