@@ -65,7 +65,12 @@ TEST(RunCli, WritesTraceAndSummary) {
   EXPECT_EQ(s.at("parameters").at("duration_s").at("source"), "set");
   EXPECT_EQ(s.at("parameters").at("vm_kind").at("value"), "circle");
   EXPECT_EQ(s.at("parameters").at("hand_k_pos_N_per_m").at("source"), "scene");
-  EXPECT_EQ(s.at("mujoco_warnings"), 0);
+  // MuJoCo's warnings: none, in the documented shape
+  EXPECT_EQ(s.at("mujoco_warnings"),
+            nlohmann::json({{"count", 0},
+                            {"kinds", nlohmann::json::object()},
+                            {"messages", nlohmann::json::array()}}));
+  EXPECT_FALSE(s.contains("mujoco_warning_kinds"));
   ASSERT_EQ(s.at("claims").size(), 3u);
   for (const auto& c : s.at("claims")) {
     for (const char* k : {"name", "value", "threshold", "comparison", "unit",
@@ -228,6 +233,31 @@ TEST(RunCli, ASceneStepOfZeroIsRefused) {
                  {scene.string(),
                   "the scene's <option timestep> must be finite and > 0, got "
                   "0 s"});
+}
+
+// Physics that goes non-finite at the first step: MuJoCo resets the state
+// and warns (on stdout, into MUJOCO_LOG.TXT, 999 times over a run, by
+// default); the run went on and exited 0. Now it stops with exit 1 and a
+// named error, MuJoCo's warning on stderr before it, nothing on stdout and
+// no log file in the working directory.
+TEST(RunCli, NonFinitePhysicsStopsTheRunWithExitOne) {
+  const fs::path dir = fresh_dir("nan_physics");
+  fs::create_directories(dir);
+  const auto r = run("run case1 --json --set hand_k_pos_N_per_m=1e30",
+                     "cd " + dir.string() + " && ");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_NE(r.err.find("vmhaptics: error: run case1: "), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("physics went non-finite at t=0.001 s (q"),
+            std::string::npos)
+      << r.err;
+  // MuJoCo's warning, once, on stderr before the error line
+  EXPECT_EQ(r.err.rfind("vmhaptics: warning: MuJoCo warning (bad", 0), 0u)
+      << r.err;
+  const std::size_t last = r.err.rfind('\n', r.err.size() - 2);
+  EXPECT_EQ(r.err.compare(last + 1, 17, "vmhaptics: error:"), 0) << r.err;
+  EXPECT_TRUE(fs::is_empty(dir)) << "left a file in the working directory";
 }
 
 }  // namespace

@@ -41,6 +41,8 @@ TEST_P(CaseTest, RunsWithoutWarningOrFault) {
   }
   EXPECT_EQ(testing::MujocoGuard::data_warnings(loop.data()), "");
   EXPECT_EQ(testing::MujocoGuard::warnings(), "");
+  EXPECT_FALSE(loop.physics_fault().has_value());
+  for (std::int64_t n : loop.mujoco_warning_counts()) EXPECT_EQ(n, 0);
   EXPECT_EQ(faults, 0);
   for (int i = 0; i < loop.model()->nq; ++i) {
     EXPECT_TRUE(std::isfinite(loop.data()->qpos[i]));
@@ -371,6 +373,46 @@ TEST(ClosedLoopBounds, CountsTheLongestRunInAWideType) {
                              "physics_step_s=1e-5"});
   EXPECT_EQ(loop.ticks_per_run(), std::int64_t{360000000});
   EXPECT_EQ(loop.substeps(), 1);
+}
+
+// ---- a physics state gone bad (issue 17) ----
+
+// A hand 1e30 N/m stiff: the first physics step's qacc is beyond MuJoCo's
+// 1e10; mj_step warns, resets the state and would carry on (here to blow
+// up again at every step). The loop keeps the first bad step and counts
+// every one, though each reset set MuJoCo's own counter back to 1.
+TEST(ClosedLoopPhysics, TheFirstBadStateIsKeptAndEveryWarningCounted) {
+  testing::MujocoGuard guard;  // MuJoCo's messages to the guard
+  ClosedLoop loop(scene(1), {"hand_k_pos_N_per_m=1e30"});
+  EXPECT_FALSE(loop.physics_fault().has_value());
+  EXPECT_NO_THROW(loop.throw_if_physics_fault());
+  TraceRow row;
+  loop.tick(&row);
+  ASSERT_TRUE(loop.physics_fault().has_value());
+  const PhysicsFault first = *loop.physics_fault();
+  EXPECT_DOUBLE_EQ(first.t_s, 0.001);
+  EXPECT_EQ(first.part, "qacc");
+  EXPECT_GE(first.index, 0);
+  EXPECT_EQ(first.message(), "physics went non-finite at t=0.001 s (qacc, DOF " +
+                                 std::to_string(first.index) + ")");
+  EXPECT_FALSE(row.state_finite);
+  try {
+    loop.throw_if_physics_fault();
+    ADD_FAILURE() << "no PhysicsError";
+  } catch (const PhysicsError& e) {
+    EXPECT_EQ(std::string(e.what()), scene(1) + ": " + first.message());
+  }
+  // tick() itself goes on (a study may look further), keeping the first
+  // fault and counting each bad step across MuJoCo's resets
+  const std::int64_t after_one = loop.mujoco_warning_counts()[mjWARN_BADQACC];
+  EXPECT_GE(after_one, 1);
+  for (int k = 0; k < 3; ++k) loop.tick(&row);
+  EXPECT_GT(loop.mujoco_warning_counts()[mjWARN_BADQACC], after_one);
+  EXPECT_DOUBLE_EQ(loop.physics_fault()->t_s, 0.001);
+  // reset() starts clean
+  loop.reset();
+  EXPECT_FALSE(loop.physics_fault().has_value());
+  for (std::int64_t n : loop.mujoco_warning_counts()) EXPECT_EQ(n, 0);
 }
 
 }  // namespace
