@@ -1,5 +1,7 @@
 #include "cli/args.h"
 
+#include <CLI/CLI.hpp>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -28,7 +30,9 @@ double to_number(const std::string& option, const std::string& raw,
   if (end == item.c_str() || *end != '\0') {
     throw UsageError(option + ": " + where + " '" + item + "' is not a number");
   }
-  if (!std::isfinite(v) || errno == ERANGE) {
+  // strtod sets ERANGE for a subnormal result too (1e-320), which is a
+  // number; only an overflow to inf is refused
+  if (!std::isfinite(v)) {
     throw UsageError(option + ": " + where + " '" + item +
                      "' is not a finite number");
   }
@@ -62,6 +66,26 @@ std::vector<double> parse_list(const std::string& option,
 
 double parse_number(const std::string& option, const std::string& text) {
   return to_number(option, text, "value");
+}
+
+void refuse_empty_numbers(CLI::App* app) {
+  const CLI::Validator non_empty(
+      [](std::string& value) {
+        return value.find_first_not_of(" \t") == std::string::npos
+                   ? std::string("the value is empty; give a number")
+                   : std::string();
+      },
+      "", "NON_EMPTY");
+  for (CLI::Option* opt : app->get_options()) {
+    const std::string type = opt->get_type_name();
+    if (opt->get_type_size_max() > 0 &&
+        (type == "FLOAT" || type == "INT" || type == "UINT")) {
+      opt->check(non_empty);
+    }
+  }
+  for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) {
+    refuse_empty_numbers(sub);
+  }
 }
 
 }  // namespace vmh::cli

@@ -9,6 +9,10 @@
 #include <string>
 #include <vector>
 
+namespace CLI {
+class App;
+}  // namespace CLI
+
 namespace vmh::cli {
 
 struct UsageError : std::runtime_error {
@@ -20,8 +24,14 @@ struct UsageError : std::runtime_error {
 std::vector<double> parse_list(const std::string& option,
                                const std::string& text, int count);
 
-// Parses one finite number.
+// Parses one finite number. Subnormal numbers (1e-320) are numbers; a
+// value that overflows to inf (1e999) is not.
 double parse_number(const std::string& option, const std::string& text);
+
+// Gives every numeric option of `app` and its sub-verbs (CLI11's FLOAT, INT
+// and UINT options, not flags) a check that refuses an empty value: CLI11
+// would read "" as 0, i.e. as the option's default. The help is unchanged.
+void refuse_empty_numbers(CLI::App* app);
 
 }  // namespace vmh::cli
 

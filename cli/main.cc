@@ -10,8 +10,14 @@
 // given times, when built with the viz library).
 //
 // Exit codes: 0 success, 2 bad usage or bad input (a device that cannot be
-// opened included), 1 any other failure, 128 + n when signal n (SIGINT,
-// SIGTERM) stopped an hw session (its trace is kept, zero torque sent).
+// opened included), 1 any other failure (a run whose physics went
+// non-finite, a MuJoCo error), 128 + n when signal n (SIGINT, SIGTERM)
+// stopped an hw session (its trace is kept, zero torque sent).
+//
+// MuJoCo's own handlers are replaced first of all (sim/mujoco_messages.h):
+// its warnings are counted and printed on stderr, one line per kind, just
+// before the program ends (before the error line, if any); nothing reaches
+// stdout or MUJOCO_LOG.TXT.
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
@@ -25,6 +31,7 @@
 #include "cli/params.h"
 #include "cli/run.h"
 #include "cli/study.h"
+#include "sim/mujoco_messages.h"
 
 namespace vmh::cli {
 // cli/identify.cc: fit the Omni model to recordings
@@ -69,9 +76,25 @@ void check_verbs(CLI::App* app, int argc, char** argv) {
   }
 }
 
+// MuJoCo's warnings of the whole run, one line per kind, on stderr
+void print_mujoco_warnings() {
+  for (const std::string& line :
+       vmh::sim::mujoco_warning_lines(vmh::sim::mujoco_warnings_so_far())) {
+    std::cerr << "vmhaptics: warning: " << line << '\n';
+  }
+}
+
+// the one error line, after the warnings
+int fail(int code, const std::string& message, const char* prefix = "error: ") {
+  print_mujoco_warnings();
+  std::cerr << "vmhaptics: " << prefix << first_line(message) << '\n';
+  return code;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  vmh::sim::install_mujoco_handlers();
   CLI::App app{
       "vmhaptics: virtual-mechanism control of under-actuated haptic devices "
       "(PHANTOM Omni), after Wickham 2010 and Beckman & Luecke 2008"};
@@ -91,6 +114,9 @@ int main(int argc, char** argv) {
   vmh::cli::register_view(&app);
 #endif
 
+  // CLI11 reads an empty value of a numeric option as 0: refuse it instead
+  vmh::cli::refuse_empty_numbers(&app);
+
   try {
     check_verbs(&app, argc, argv);
     app.parse(argc, argv);
@@ -101,20 +127,16 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "vmhaptics: error: " << first_line(e.what()) << '\n';
-    return 2;
+    return fail(2, e.what());
   } catch (const vmh::cli::UsageError& e) {
-    std::cerr << "vmhaptics: error: " << first_line(e.what()) << '\n';
-    return 2;
+    return fail(2, e.what());
   } catch (const vmh::DeviceOpenError& e) {
-    std::cerr << "vmhaptics: error: " << first_line(e.what()) << '\n';
-    return 2;
+    return fail(2, e.what());
   } catch (const vmh::cli::SignalStop& e) {
-    std::cerr << "vmhaptics: " << first_line(e.what()) << '\n';
-    return 128 + e.signal;
+    return fail(128 + e.signal, e.what(), "");
   } catch (const std::exception& e) {
-    std::cerr << "vmhaptics: error: " << first_line(e.what()) << '\n';
-    return 1;
+    return fail(1, e.what());
   }
+  print_mujoco_warnings();
   return 0;
 }

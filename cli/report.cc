@@ -58,7 +58,7 @@ studies::RenderFn case_renderer(const fs::path& dir) {
       {
         const sim::ClosedLoop loop(scene_path, {});
         const auto& segs = loop.script().segments();
-        t_s = 0.5 * loop.ticks_per_run() *
+        t_s = 0.5 * static_cast<double>(loop.ticks_per_run()) *
               loop.controller_params().servo_period_s;
         for (const sim::ScriptSegment& g : segs) {
           if (g.name == "off_out_misaligned") {

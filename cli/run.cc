@@ -16,6 +16,7 @@
 
 #include "cli/args.h"
 #include "report/progress.h"
+#include "sim/case_params.h"
 #include "studies/run_case.h"
 
 namespace vmh::cli {
@@ -24,11 +25,12 @@ namespace {
 struct RunOptions {
   std::string target;
   bool all = false;
-  double duration_s = 0.0;  // 0: the scene's
+  std::string duration_s;  // not given: the scene's
   std::string out;
   std::vector<std::string> sets;
   int jobs = 0;  // 0: one per core
   bool json = false;
+  bool duration_given = false;
   std::string model;  // a calibrated Omni MJCF; empty: the scene's own
 };
 
@@ -70,10 +72,19 @@ void run(const RunOptions& o) {
   if (o.all == !o.target.empty()) {
     throw UsageError("run: give one case or scene, or --all");
   }
-  if (o.duration_s < 0.0) throw UsageError("--duration: must be > 0");
   std::vector<std::string> sets = o.sets;
-  if (o.duration_s > 0.0) {
-    sets.push_back("duration_s=" + std::to_string(o.duration_s));
+  if (o.duration_given) {
+    // checked here, before any scene is read, against duration_s's row of
+    // the table; passed on exactly (%.17g round-trips)
+    const double d = parse_number("--duration", o.duration_s);
+    try {
+      sim::check_param_number(*sim::find_param("duration_s"), d, "--duration");
+    } catch (const sim::ParamError& e) {
+      throw UsageError(e.what());
+    }
+    char text[40];
+    std::snprintf(text, sizeof text, "%.17g", d);
+    sets.push_back(std::string("duration_s=") + text);
   }
 
   // resolve every scene first, so that a bad name writes nothing
@@ -158,8 +169,15 @@ void register_run(CLI::App* app) {
   cmd->add_option("target", o->target,
                   "case1..case6, or the path of a scene .xml");
   cmd->add_flag("--all", o->all, "run the six thesis cases");
-  cmd->add_option("--duration", o->duration_s,
-                  "simulated seconds (default: the scene's duration_s, 20)");
+  cmd->add_option_function<std::string>(
+      "--duration",
+      [o](const std::string& text) {
+        o->duration_s = text;
+        o->duration_given = true;
+      },
+      "simulated seconds, > 0 and <= 3600 (default: the scene's duration_s, "
+      "20)")
+      ->type_name("FLOAT");
   cmd->add_option("--out", o->out,
                   "write DIR/<case>/trace.csv and DIR/<case>/summary.json");
   cmd->add_option("--set", o->sets,

@@ -355,8 +355,13 @@ ControlStatus Controller::saturate_and_map(const Mat3& Jv_arm,
   // |F| only when over the limit: the square root's latency sat on the
   // tick's critical path in perf
   const double F_limit = params_.force_limit_N;
-  if (F.squaredNorm() > F_limit * F_limit) {
-    F *= F_limit / F.norm();
+  const double F2 = F.squaredNorm();
+  // |F|^2 overflows for |F| > ~1e154 N (a gain of 1e153, say): F / |F|
+  // would be 0 and a zero force would pass for a saturated one. A
+  // non-finite intermediate is a numerical fault, whatever it came from
+  if (!std::isfinite(F2)) return kStatusNumericalFault;
+  if (F2 > F_limit * F_limit) {
+    F *= F_limit / std::sqrt(F2);
     st |= kStatusForceSaturated;
   }
   // eq. 3.12 with the wrist-centre Jacobian's linear rows (m/rad) and the
@@ -379,6 +384,7 @@ ControlStatus Controller::saturate_and_map(const Mat3& Jv_arm,
     tau_motor *= scale;
     st |= kStatusTorqueSaturated;
   }
+  if (!tau_motor.allFinite() || !F_base.allFinite()) return kStatusNumericalFault;
   out->force_device_N = F;
   out->force_base_N = F_base;
   out->tau_dh_Nm = tau;
@@ -411,14 +417,19 @@ ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept 
   out->theta_v = theta_v_;
   out->theta_r = theta_r_;
 
-  // 5. the device force and joint torques
-  if (!out->f_motion.allFinite() || !out->e.allFinite()) {
+  // 5. the device force and joint torques; a non-finite value on the way
+  // (saturate_and_map writes nothing then) leaves them zero
+  ControlStatus mapped = kStatusNumericalFault;
+  if (out->f_motion.allFinite() && out->e.allFinite()) {
+    mapped = saturate_and_map(arm.Jv_arm, out);
+  }
+  if ((mapped & kStatusNumericalFault) != 0u) {
     out->status = st | kStatusNumericalFault;
     out->f_motion.setZero();
     reset();
     return out->status;
   }
-  st |= saturate_and_map(arm.Jv_arm, out);
+  st |= mapped;
   out->status = st;
   return st;
 }

@@ -198,7 +198,9 @@ class Controller {
                  ControlOutput* out) const noexcept;
   // rows 0-2 of f_motion saturated to the force limit, tau = J_r^T F
   // (eq. 3.12, J_r the wrist centre's Jacobian for q1..q3 from the same
-  // pass as the pose), the motor torques scaled into their limits
+  // pass as the pose), the motor torques scaled into their limits; only
+  // kStatusNumericalFault, writing nothing, when |F|^2 or a torque is not
+  // finite (an overflow must not pass for a saturation)
   ControlStatus saturate_and_map(const Mat3& Jv_arm,
                                  ControlOutput* out) const noexcept;
   // a non-finite joint angle: zero output, restart e_dot

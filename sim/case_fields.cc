@@ -44,6 +44,18 @@ struct Row : ParamSpec {
     return *this;
   }
   Row& flag01() { return whole_in(0, 1); }
+  Row& in_range(double l, double h) {
+    rule = ParamRule::kInRange;
+    lo = l;
+    hi = h;
+    return *this;
+  }
+  // with positive() or non_negative(): also <= h
+  Row& at_most(double h) {
+    has_max = true;
+    hi = h;
+    return *this;
+  }
   Row& infinite_ok() { allow_inf = true; return *this; }
   Row& note(const char* n) { range_note = n; return *this; }
   Row& source(const char* r) { reference = r; return *this; }
@@ -202,11 +214,12 @@ const std::vector<ParamSpec>& case_fields() {
           .ctl("--placement"),
       numeric("controller", "servo_period_s", 1, "0.001", "s",
               "controller period T: the e_dot difference uses it, the torque "
-              "is held over it (ZOH)",
+              "is held over it (ZOH). 1e-5 s (100 kHz) to 1 s: the Omni's "
+              "servo loop runs at 1 kHz",
               [](CaseParams* p, const ParamValue& v) {
                 p->controller.servo_period_s = item(v);
               })
-          .positive()
+          .in_range(1e-5, 1.0)
           .ctl("--servo-period-s"),
       numeric("controller", "force_limit_N", 1, "3.3", "N",
               "force saturation (Omni peak)",
@@ -228,12 +241,14 @@ const std::vector<ParamSpec>& case_fields() {
 
       // ---- the simulator ----
       numeric("sim", "physics_step_s", 1, "0", "s",
-              "MuJoCo step h; 0 keeps the scene's `<option timestep>`; T/h must "
-              "be a whole number",
+              "MuJoCo step h; 0 keeps the scene's `<option timestep>` (which "
+              "must then be finite and > 0); T/h must be a whole number",
               [](CaseParams* p, const ParamValue& v) {
                 p->sim.physics_step_s = item(v);
               })
-          .non_negative(),
+          .non_negative()
+          .at_most(1.0)
+          .note("servo_period_s / h a whole number in [1, 1000000]"),
       text("sim", "integrator", "scene", "scene, euler, implicit, rk4",
            "MuJoCo integrator: scene (keep the scene's `<option integrator>`), "
            "euler, implicit or rk4",
@@ -255,11 +270,16 @@ const std::vector<ParamSpec>& case_fields() {
                 p->sim.quantize = flag(v);
               })
           .flag01(),
-      numeric("sim", "duration_s", 1, "20", "s", "simulated time of a run",
+      numeric("sim", "duration_s", 1, "20", "s",
+              "simulated time of a run, at least one servo period; at most "
+              "an hour, as `run` holds its whole trace in memory (0.86 kB a "
+              "tick, 3.1 GB for 3600 s at 1 kHz; about twice that with "
+              "--out, which builds trace.csv in memory too)",
               [](CaseParams* p, const ParamValue& v) {
                 p->sim.duration_s = item(v);
               })
-          .positive(),
+          .positive()
+          .at_most(3600.0),
 
       // ---- the hand script ----
       text("script", "script", "thesis", "thesis, hold, pivot, spin",
@@ -330,7 +350,9 @@ const std::vector<ParamSpec>& case_fields() {
                 p->sim.jitter_min_s = v.numbers.at(0);
                 p->sim.jitter_max_s = v.numbers.at(1);
               })
-          .note("0 0, or 0 < min <= max"),
+          .non_negative()
+          .at_most(1.0)
+          .note("0 0, or 0 < min <= max; max / the physics step <= 1000000"),
       numeric("sim", "jitter_seed", 1, "1", "-",
               "seed of the servo-period draws (whole number)",
               [](CaseParams* p, const ParamValue& v) {

@@ -116,27 +116,7 @@ void check_rule(const ParamSpec& spec, const ParamValue& v) {
     }
     return;
   }
-  for (double x : v.numbers) {
-    const std::string got = ", got " + format_number(x);
-    switch (spec.rule) {
-      case ParamRule::kAny:
-        break;
-      case ParamRule::kPositive:
-        if (!(x > 0.0)) throw ParamError(field_at(spec, v) + " must be > 0" + got);
-        break;
-      case ParamRule::kNonNegative:
-        if (!(x >= 0.0)) {
-          throw ParamError(field_at(spec, v) + " must be >= 0" + got);
-        }
-        break;
-      case ParamRule::kWhole:
-        if (x != std::floor(x) || x < spec.lo || x > spec.hi) {
-          throw ParamError(field_at(spec, v) + " must be " +
-                           spec.range_text() + got);
-        }
-        break;
-    }
-  }
+  for (double x : v.numbers) check_param_number(spec, x, v.where);
 }
 
 }  // namespace
@@ -167,21 +147,49 @@ std::string param_names() {
   return all;
 }
 
+void check_param_number(const ParamSpec& spec, double x,
+                        const std::string& where) {
+  bool ok = true;
+  switch (spec.rule) {
+    case ParamRule::kAny: break;
+    case ParamRule::kPositive: ok = x > 0.0; break;
+    case ParamRule::kNonNegative: ok = x >= 0.0; break;
+    case ParamRule::kWhole:
+      ok = x == std::floor(x) && x >= spec.lo && x <= spec.hi;
+      break;
+    case ParamRule::kInRange: ok = x >= spec.lo && x <= spec.hi; break;
+  }
+  if (spec.has_max && !(x <= spec.hi)) ok = false;
+  if (!ok) {
+    throw ParamError(where + ": field '" + spec.name + "' must be " +
+                     spec.rule_text() + ", got " + format_number(x));
+  }
+}
+
+std::string ParamSpec::rule_text() const {
+  if (is_text) return "";
+  std::string r;
+  switch (rule) {
+    case ParamRule::kAny: return "";
+    case ParamRule::kPositive: r = "> 0"; break;
+    case ParamRule::kNonNegative: r = allow_inf ? ">= 0, or inf" : ">= 0"; break;
+    case ParamRule::kWhole:
+      return lo == 0 && hi == 1 ? std::string("0 or 1")
+                                : "a whole number in [" + format_number(lo) +
+                                      ", " + format_number(hi) + "]";
+    case ParamRule::kInRange:
+      return "in [" + format_number(lo) + ", " + format_number(hi) + "]";
+  }
+  if (has_max) r += " and <= " + format_number(hi);
+  return r;
+}
+
 std::string ParamSpec::range_text() const {
   std::string r;
   if (is_text) {
     r = words;
   } else {
-    switch (rule) {
-      case ParamRule::kAny: r = "any"; break;
-      case ParamRule::kPositive: r = "> 0"; break;
-      case ParamRule::kNonNegative: r = allow_inf ? ">= 0, or inf" : ">= 0"; break;
-      case ParamRule::kWhole:
-        r = lo == 0 && hi == 1 ? std::string("0 or 1")
-                               : "a whole number in [" + format_number(lo) +
-                                     ", " + format_number(hi) + "]";
-        break;
-    }
+    r = rule == ParamRule::kAny ? "any" : rule_text();
     if (size > 1 && rule != ParamRule::kAny) r = "each " + r;
   }
   if (range_note != nullptr) r += "; " + std::string(range_note);

@@ -35,6 +35,17 @@ struct ParamError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The bounds on a run's counts, which ClosedLoop checks when it is made (a
+// SimError naming the parameters otherwise) and the table's range notes
+// name. Physics steps per servo tick: servo_period_s / the physics step,
+// and with servo jitter its longest period / the step, a whole number in
+// [1, kMaxSubstepsPerTick] (the precision study's finest step is T / 500).
+// Ticks per run: duration_s / servo_period_s, in [1, kMaxTicksPerRun]; the
+// table's ranges (duration_s <= 3600 s, servo_period_s >= 1e-5 s) keep it
+// below 3.6e8.
+inline constexpr std::int64_t kMaxSubstepsPerTick = 1000000;
+inline constexpr std::int64_t kMaxTicksPerRun = 1000000000;
+
 // Where a value came from.
 enum class ValueSource { kDefault, kScene, kOverride };
 const char* value_source_name(ValueSource s);  // default, scene, set
@@ -134,12 +145,14 @@ struct CaseParams {
   std::vector<ParamValue> values;  // one per row of case_fields()
 };
 
-// The check on a numeric parameter, item by item.
+// The check on a numeric parameter, item by item. kPositive and
+// kNonNegative may also have a maximum (ParamSpec::has_max: <= hi).
 enum class ParamRule {
   kAny,
   kPositive,     // > 0
   kNonNegative,  // >= 0
   kWhole,        // whole number in [lo, hi]
+  kInRange,      // in [lo, hi]
 };
 
 // One row of the table.
@@ -152,7 +165,8 @@ struct ParamSpec {
   const char* doc;
   const char* group;  // controller, sim, hand, script, case
   ParamRule rule = ParamRule::kAny;
-  double lo = 0.0, hi = 0.0;   // kWhole
+  double lo = 0.0, hi = 0.0;   // kWhole, kInRange; has_max: hi
+  bool has_max = false;        // kPositive, kNonNegative: also <= hi
   bool allow_inf = false;      // +inf is a valid value
   const char* words = nullptr; // text: the valid values, ", "-separated
   const char* range_note = nullptr;  // a rule beyond `rule`, for the docs
@@ -169,8 +183,11 @@ struct ParamSpec {
   bool ctl_flag = false;
   void (*bind)(CaseParams*, const ParamValue&) = nullptr;
 
-  // the range as text: "> 0", "0 .. 64, whole", "circle, sphere, surface"
+  // the range as text: "> 0", "> 0 and <= 3600", "a whole number in [0,
+  // 64]", "circle, sphere, surface"; with "each " for a vector and the note
   std::string range_text() const;
+  // the rule alone, for one item: "> 0 and <= 3600"; "" for kAny and text
+  std::string rule_text() const;
   // the default as text, with the surface's and ctl's where they differ
   std::string default_text() const;
 };
@@ -182,6 +199,11 @@ const std::vector<ParamSpec>& case_fields();
 const ParamSpec* find_param(const std::string& name);
 // all names, ", "-separated, for messages
 std::string param_names();
+
+// Checks one item of a numeric parameter against its row's rule; throws
+// ParamError "<where>: field '<name>' must be <rule_text>, got <x>" (x as
+// %.9g, so 1e-7 shows as 1e-07). Finiteness is the loader's (store) check.
+void check_param_number(const ParamSpec& spec, double x, const std::string& where);
 
 // One value as text, with where it came from. `where` names the file,
 // "--set" or the ctl option in messages.

@@ -5,6 +5,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "sim/case_params_detail.h"
 
 namespace vmh::sim {
 namespace {
@@ -21,6 +22,9 @@ std::uint64_t next_random(std::uint64_t* state) {
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
   return z ^ (z >> 31);
 }
+
+// a number in a message: %g-style, 9 significant digits (1e-07, 0.001)
+std::string num(double v) { return detail::format_number(v); }
 
 bool all_finite(const mjtNum* v, int n) {
   for (int i = 0; i < n; ++i) {
@@ -80,17 +84,42 @@ void ClosedLoop::apply_model_options() {
 }
 
 void ClosedLoop::setup_timing() {
+  // every count below is computed in double, checked against its bound and
+  // only then made an integer; the table's ranges (sim/case_fields.cc)
+  // have already refused non-finite values, T outside [1e-5, 1] s and a
+  // duration outside (0, 3600] s
   const double T = config_.controller.servo_period_s;
   const double h = model_->opt.timestep;
+  const std::string step_name =
+      config_.sim.physics_step_s > 0.0 ? "physics_step_s"
+                                       : "the scene's <option timestep>";
+  if (!std::isfinite(h) || !(h > 0.0)) {
+    throw SimError(path_ + ": " + step_name + " must be finite and > 0, got " +
+                   num(h) + " s");
+  }
   const double n = std::round(T / h);
-  if (n < 1.0 || std::abs(n * h - T) > 1e-9 * T) {
-    throw SimError(path_ + ": servo_period_s (" + std::to_string(T) +
+  if (!(n >= 1.0 && n <= static_cast<double>(kMaxSubstepsPerTick))) {
+    throw SimError(path_ + ": servo_period_s / " + step_name + " (" + num(T) +
+                   " s / " + num(h) + " s) must be a whole number of physics "
+                   "steps in [1, " + std::to_string(kMaxSubstepsPerTick) +
+                   "], got " + num(T / h));
+  }
+  if (std::abs(n * h - T) > 1e-9 * T) {
+    throw SimError(path_ + ": servo_period_s (" + num(T) +
                    " s) must be a whole multiple of the physics step (" +
-                   std::to_string(h) + " s)");
+                   num(h) + " s)");
   }
   substeps_ = static_cast<int>(n);
   duration_s_ = config_.sim.duration_s;
-  ticks_per_run_ = static_cast<int>(std::llround(duration_s_ / T));
+  const double ticks = std::round(duration_s_ / T);
+  if (!(ticks >= 1.0 && ticks <= static_cast<double>(kMaxTicksPerRun))) {
+    throw SimError(path_ + ": duration_s (" + num(duration_s_) +
+                   " s) must last from 1 to " +
+                   std::to_string(kMaxTicksPerRun) +
+                   " servo periods (servo_period_s = " + num(T) +
+                   " s), got " + num(duration_s_ / T));
+  }
+  ticks_per_run_ = static_cast<std::int64_t>(ticks);
   jitter_seed_ = config_.sim.jitter_seed;
   setup_jitter(h);
 }
@@ -101,23 +130,31 @@ void ClosedLoop::setup_jitter(double h) {
                               config_.sim.jitter_max_s};
   if (!(jitter_s[1] > 0.0)) return;
   jitter_ = true;
-  jitter_lo_ = static_cast<int>(std::lround(jitter_s[0] / h));
-  jitter_hi_ = static_cast<int>(std::lround(jitter_s[1] / h));
-  if (jitter_lo_ < 1) {
+  const double steps[2] = {std::round(jitter_s[0] / h),
+                           std::round(jitter_s[1] / h)};
+  if (steps[0] < 1.0) {
     throw SimError(path_ + ": servo_jitter_s's shortest period (" +
-                   std::to_string(jitter_s[0]) +
-                   " s) is less than one physics step (" + std::to_string(h) +
-                   " s)");
+                   num(jitter_s[0]) + " s) is less than one physics step (" +
+                   num(h) + " s)");
+  }
+  if (!(steps[1] <= static_cast<double>(kMaxSubstepsPerTick))) {
+    throw SimError(path_ + ": servo_jitter_s's longest period / the physics "
+                   "step (" + num(jitter_s[1]) + " s / " + num(h) +
+                   " s) must be at most " +
+                   std::to_string(kMaxSubstepsPerTick) +
+                   " physics steps, got " + num(jitter_s[1] / h));
   }
   // the periods are drawn in whole physics steps: ends that are not whole
   // steps would be moved without a word
   for (double end_s : jitter_s) {
     if (std::abs(std::round(end_s / h) * h - end_s) > 1e-9 * end_s) {
-      throw SimError(path_ + ": servo_jitter_s (" + std::to_string(end_s) +
+      throw SimError(path_ + ": servo_jitter_s (" + num(end_s) +
                      " s) must be a whole multiple of the physics step (" +
-                     std::to_string(h) + " s); set physics_step_s");
+                     num(h) + " s); set physics_step_s");
     }
   }
+  jitter_lo_ = static_cast<int>(steps[0]);
+  jitter_hi_ = static_cast<int>(steps[1]);
 }
 
 void ClosedLoop::build_controller() {
@@ -196,9 +233,8 @@ Joints ClosedLoop::start_pose() {
   }
   if (best < 0) {
     throw SimError(path_ + ": the script's start pose (" +
-                   std::to_string(start.p_mm.x()) + ", " +
-                   std::to_string(start.p_mm.y()) + ", " +
-                   std::to_string(start.p_mm.z()) +
+                   num(start.p_mm.x()) + ", " + num(start.p_mm.y()) + ", " +
+                   num(start.p_mm.z()) +
                    ") mm cannot be reached within the joint ranges; change "
                    "script_dir, vm_pivot_mm or vm_length_mm");
   }
@@ -220,6 +256,18 @@ bool ClosedLoop::finished() const {
   return time_s() >= duration_s_ - 0.5 * model_->opt.timestep;
 }
 
+std::string PhysicsFault::message() const {
+  std::string where = part;
+  if (index >= 0) {
+    where += (part == "ctrl" ? ", actuator " : ", DOF ") + std::to_string(index);
+  }
+  return "physics went non-finite at t=" + num(t_s) + " s (" + where + ")";
+}
+
+void ClosedLoop::throw_if_physics_fault() const {
+  if (physics_fault_) throw PhysicsError(path_ + ": " + physics_fault_->message());
+}
+
 int ClosedLoop::draw_substeps() {
   if (!jitter_) return substeps_;
   const auto span = static_cast<std::uint64_t>(jitter_hi_ - jitter_lo_ + 1);
@@ -238,6 +286,10 @@ void ClosedLoop::reset() {
   rng_state_ = jitter_seed_;
   energy_motor_J_ = 0.0;
   energy_hand_J_ = 0.0;
+  // mj_resetData cleared mjData::warning[]
+  warning_counts_.fill(0);
+  warning_seen_.fill(0);
+  physics_fault_.reset();
   controller_->reset();
   if (reference_) reference_->reset();
   // write the start angles through the joint addresses
@@ -355,9 +407,13 @@ void ClosedLoop::tick(TraceRow* row) {
   mjModel* m = model_.get();
   mjData* d = data_.get();
   const int n = draw_substeps();
+  const double h = m->opt.timestep;
+  bool bad_step = false;
   for (int i = 0; i < n; ++i) {
     mju_copy(qpos_before_.data(), d->qpos, m->nq);
+    const double time_before = d->time;
     mj_step(m, d);
+    if (check_step(t + (i + 1) * h, time_before)) bad_step = true;
     // the true motion over the step, and the work of the forces held on it
     mj_differentiatePos(m, dq_.data(), 1.0, qpos_before_.data(), d->qpos);
     energy_motor_J_ += mju_dot(d->qfrc_actuator, dq_.data(), m->nv);
@@ -369,11 +425,50 @@ void ClosedLoop::tick(TraceRow* row) {
   row->energy_hand_J = energy_hand_J_;
   mj_mulM(m, d, mv_.data(), d->qvel);
   row->kinetic_J = 0.5 * mju_dot(d->qvel, mv_.data(), m->nv);
-  row->state_finite = all_finite(d->qpos, m->nq) && all_finite(d->qvel, m->nv) &&
-                      all_finite(d->qacc, m->nv) && all_finite(d->ctrl, m->nu);
+  // MuJoCo resets a bad state, so the state after the tick may look fine
+  row->state_finite = !bad_step && all_finite(d->qpos, m->nq) &&
+                      all_finite(d->qvel, m->nv) && all_finite(d->qacc, m->nv) &&
+                      all_finite(d->ctrl, m->nu);
   row->hand_force_N = base_to_device_vector(hand_->force_N());
   ++tick_count_;
   substep_count_ += n;
+}
+
+bool ClosedLoop::check_step(double t_s, double time_before) {
+  const mjModel* m = model_.get();
+  const mjData* d = data_.get();
+  // mj_step's checks (mj_checkPos, mj_checkVel, mj_checkAcc) count a bad
+  // value in d->warning[] and reset the state, which clears the counters
+  // (and MuJoCo's clock) before counting it: after a reset every count is
+  // new. A step that did not move MuJoCo's clock forward was reset
+  const bool reset = !(d->time > time_before);
+  bool bad = false;
+  for (int k = 0; k < mjNWARNING; ++k) {
+    const int now = d->warning[k].number;
+    const int seen = warning_seen_[static_cast<std::size_t>(k)];
+    const int added = reset || now < seen ? now : now - seen;
+    warning_seen_[static_cast<std::size_t>(k)] = now;
+    if (added == 0) continue;
+    warning_counts_[static_cast<std::size_t>(k)] += added;
+    const bool bad_kind = k == mjWARN_BADQPOS || k == mjWARN_BADQVEL ||
+                          k == mjWARN_BADQACC || k == mjWARN_BADCTRL;
+    if (bad_kind && !bad) {
+      bad = true;
+      if (!physics_fault_) {
+        static const char* const kParts[] = {"qpos", "qvel", "qacc", "ctrl"};
+        physics_fault_ = PhysicsFault{t_s, kParts[k - mjWARN_BADQPOS],
+                                      d->warning[k].lastinfo};
+      }
+    }
+  }
+  if (!bad && !(all_finite(d->qpos, m->nq) && all_finite(d->qvel, m->nv))) {
+    bad = true;
+    if (!physics_fault_) {
+      physics_fault_ = PhysicsFault{
+          t_s, all_finite(d->qpos, m->nq) ? "qvel" : "qpos", -1};
+    }
+  }
+  return bad;
 }
 
 }  // namespace vmh::sim

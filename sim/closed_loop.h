@@ -31,9 +31,11 @@
 #ifndef VMHAPTICS_SIM_CLOSED_LOOP_H_
 #define VMHAPTICS_SIM_CLOSED_LOOP_H_
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -89,6 +91,25 @@ struct TraceRow {
   bool state_finite = true;
 };
 
+// Where MuJoCo's state went bad: the first physics step after which
+// mjData::warning[] counted a bad qpos, qvel, qacc or ctrl (NaN, inf or
+// beyond 1e10: MuJoCo then resets the state and carries on), or qpos or
+// qvel was not finite.
+struct PhysicsFault {
+  double t_s = 0.0;   // the loop's time at the end of that step
+  std::string part;   // qpos, qvel, qacc or ctrl
+  int index = -1;     // the DOF (ctrl: the actuator) MuJoCo named; -1: none
+  // "physics went non-finite at t=0.002 s (qacc, DOF 3)"
+  std::string message() const;
+};
+
+// A run stopped by a PhysicsFault: a failure of the run (exit 1), not bad
+// input.
+class PhysicsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class ClosedLoop {
  public:
   // Loads the scene, reads its parameters (with `overrides`), builds the
@@ -110,8 +131,25 @@ class ClosedLoop {
 
   // Advances one servo period and describes it in *row. Past duration_s
   // (a run continued beyond its script) the hand holds the script's last
-  // target, at rest.
+  // target, at rest. After every physics step it reads mjData::warning[]
+  // (counted per kind, mujoco_warning_counts()) and checks the state; the
+  // first bad state is kept as physics_fault() and that tick's
+  // row->state_finite is false. tick() itself goes on (a study may want to
+  // see what follows): a run that must stop calls throw_if_physics_fault()
+  // after each tick.
   void tick(TraceRow* row);
+
+  // the first bad physics state since reset(), if any
+  const std::optional<PhysicsFault>& physics_fault() const {
+    return physics_fault_;
+  }
+  // throws PhysicsError(physics_fault()->message()) if there is one
+  void throw_if_physics_fault() const;
+  // MuJoCo's per-step warnings since reset(), by mjtWarning: every count
+  // mjData::warning[] reached, summed over its resets
+  const std::array<std::int64_t, mjNWARNING>& mujoco_warning_counts() const {
+    return warning_counts_;
+  }
 
   // Another gain set evaluated on every reading, without acting
   // (TraceRow::force_reference_N).
@@ -120,7 +158,7 @@ class ClosedLoop {
   double time_s() const;
   // the run's length in ticks at the nominal period; with servo jitter the
   // count differs, so loop until finished()
-  int ticks_per_run() const { return ticks_per_run_; }
+  std::int64_t ticks_per_run() const { return ticks_per_run_; }
   // whether time_s() has reached duration_s
   bool finished() const;
   // physics steps per tick at the nominal period
@@ -183,6 +221,10 @@ class ClosedLoop {
 
   // the next tick's physics steps (drawn when jittered)
   int draw_substeps();
+  // after a physics step that ended at t_s (MuJoCo's clock read
+  // time_before it): count MuJoCo's warnings, keep the first bad state;
+  // true if this step's state is bad
+  bool check_step(double t_s, double time_before);
   // the wrist pose (device frame) a grip target asks for
   ScriptPose wrist_pose_of(const HandTargetState& grip) const;
 
@@ -202,21 +244,25 @@ class ClosedLoop {
   Joints q_start_dh_ = Joints::Zero();
   Mat3 R_start_base_ = Mat3::Identity();  // stylus frame at the start pose
   int substeps_ = 1;
-  int ticks_per_run_ = 0;
+  std::int64_t ticks_per_run_ = 0;
   double duration_s_ = 0.0;  // the script's, read once (the tick reads it)
-  long tick_count_ = 0;
+  std::int64_t tick_count_ = 0;
   // servo jitter: steps per tick drawn from [lo, hi]; the generator's state
   bool jitter_ = false;
   int jitter_lo_ = 1, jitter_hi_ = 1;
   std::uint64_t jitter_seed_ = 1;
   std::uint64_t rng_state_ = 1;
-  long substep_count_ = 0;  // physics steps since t = 0
+  std::int64_t substep_count_ = 0;  // physics steps since t = 0
   bool manual_hand_ = false;
   HandTargetState manual_target_;
   // passivity observer
   double energy_motor_J_ = 0.0;
   double energy_hand_J_ = 0.0;
   std::vector<mjtNum> qpos_before_, dq_, mv_;
+  // MuJoCo's warnings and the first bad state (check_step)
+  std::array<std::int64_t, mjNWARNING> warning_counts_{};
+  std::array<int, mjNWARNING> warning_seen_{};  // d->warning[].number
+  std::optional<PhysicsFault> physics_fault_;
 };
 
 }  // namespace vmh::sim

@@ -3,6 +3,8 @@
 #include <fstream>
 #include <mutex>
 
+#include "sim/mujoco_messages.h"
+
 namespace vmh::sim {
 namespace {
 
@@ -36,6 +38,7 @@ ModelPtr load_locked(const std::string& path) {
 }  // namespace
 
 ModelPtr load_model(const std::string& path) {
+  install_mujoco_handlers();
   std::lock_guard<std::mutex> lock(xml_mutex());
   return load_locked(path);
 }
@@ -43,6 +46,7 @@ ModelPtr load_model(const std::string& path) {
 void save_edited_model_xml(const std::string& in_path,
                            const std::function<void(mjModel*)>& edit,
                            const std::string& out_path) {
+  install_mujoco_handlers();
   std::lock_guard<std::mutex> lock(xml_mutex());
   ModelPtr m = load_locked(in_path);
   if (edit) edit(m.get());

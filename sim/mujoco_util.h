@@ -31,7 +31,9 @@ using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
 using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 
 // Compiles an MJCF file. Throws SimError "<path>: <MuJoCo's message>" when the
-// file is missing or MuJoCo rejects it.
+// file is missing or MuJoCo rejects it. Installs the project's MuJoCo error
+// and warning handlers first (sim/mujoco_messages.h), as does
+// save_edited_model_xml.
 ModelPtr load_model(const std::string& path);
 
 // Loads in_path, calls edit on the model, and writes it as MJCF to out_path

@@ -250,7 +250,8 @@ CaseLeanness measure_case(const std::pair<std::string, std::string>& scene,
   cl.ngeom = first.model()->ngeom;
   cl.substeps = first.substeps();
   cl.step_s = first.model()->opt.timestep;
-  cl.ticks = first.ticks_per_run();
+  // at most sim::kMaxTicksPerRun (1e9), which an int holds
+  cl.ticks = static_cast<int>(first.ticks_per_run());
 
   // each repeat starts one variant further on, so that no variant always
   // runs first (cold caches) or right after the same neighbour

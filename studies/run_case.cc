@@ -12,6 +12,7 @@
 #include "controller/device_frame.h"
 #include "report/output_file.h"
 #include "report/parallel.h"
+#include "sim/mujoco_messages.h"
 #include "studies/plot_svg.h"
 
 namespace vmh::studies {
@@ -95,6 +96,28 @@ nlohmann::json claim_json(const Claim& c) {
           {"prediction_note", c.prediction_note},
           {"saturated_fraction", c.saturated_fraction},
           {"regime", c.regime}};
+}
+
+nlohmann::json mujoco_warnings_json(
+    const std::array<std::int64_t, mjNWARNING>& per_step,
+    const MujocoWarningTally& messages) {
+  nlohmann::json kinds = nlohmann::json::object();
+  std::int64_t count = 0;
+  for (int k = 0; k < mjNWARNING; ++k) {
+    const std::int64_t n = per_step[static_cast<std::size_t>(k)];
+    if (n > 0) kinds[mujoco_warning_name(k)] = n;
+    count += n;
+  }
+  // what MuJoCo said besides its per-step warnings (those are counted above
+  // at every step; it says each only once until the state is reset)
+  const std::int64_t other = messages.count("other");
+  if (other > 0) kinds["other"] = other;
+  count += other;
+  nlohmann::json texts = nlohmann::json::array();
+  for (const MujocoWarningTally::Entry& e : messages.entries) {
+    texts.push_back({{"kind", e.kind}, {"text", e.text}, {"count", e.count}});
+  }
+  return {{"count", count}, {"kinds", kinds}, {"messages", texts}};
 }
 
 nlohmann::json metrics_json(const RunMetrics& m) {
@@ -191,10 +214,24 @@ std::vector<TraceRow> run_to_end(ClosedLoop* loop) {
   // with servo jitter the number of ticks is not known ahead: run until the
   // simulated time is up
   std::vector<TraceRow> rows;
-  rows.reserve(static_cast<std::size_t>(loop->ticks_per_run()));
+  try {
+    rows.reserve(static_cast<std::size_t>(loop->ticks_per_run()));
+  } catch (const std::exception&) {
+    char gb[32];
+    std::snprintf(gb, sizeof gb, "%.3g",
+                  static_cast<double>(loop->ticks_per_run()) *
+                      static_cast<double>(sizeof(TraceRow)) * 1e-9);
+    throw std::runtime_error("the trace of " +
+                             std::to_string(loop->ticks_per_run()) +
+                             " ticks (" + gb +
+                             " GB) does not fit in memory; shorten duration_s");
+  }
+  // a bad physics state (NaN, inf or beyond 1e10, which MuJoCo resets)
+  // ends the run at the end of its tick: a failure (exit 1), not a result
   while (!loop->finished()) {
     rows.emplace_back();
     loop->tick(&rows.back());
+    loop->throw_if_physics_fault();
   }
   return rows;
 }
@@ -218,6 +255,8 @@ CaseResult run_case(const std::string& name, const std::string& scene,
   result.name = name;
   result.scene = scene;
 
+  // MuJoCo's warnings during this run (this thread's), for the summary
+  MujocoWarningScope mujoco_messages;
   ClosedLoop loop(scene, overrides, omni_model_hook(model_file));
   const int thesis_case = loop.config().thesis_case;
   const auto start = std::chrono::steady_clock::now();
@@ -307,13 +346,8 @@ CaseResult run_case(const std::string& name, const std::string& scene,
     // the hand's values together as well, each with where it comes from
     if (std::strcmp(f.group, "hand") == 0) params["hand"][f.name] = params[f.name];
   }
-  nlohmann::json warnings = nlohmann::json::object();
-  int warning_total = 0;
-  for (int i = 0; i < mjNWARNING; ++i) {
-    const int n = loop.data()->warning[i].number;
-    warning_total += n;
-    if (n > 0) warnings[std::to_string(i)] = n;
-  }
+  const nlohmann::json warnings =
+      mujoco_warnings_json(loop.mujoco_warning_counts(), mujoco_messages.tally());
   nlohmann::json claims = nlohmann::json::array();
   for (const Claim& c : result.claims) claims.push_back(claim_json(c));
   static const char* const kIntegrators[] = {"Euler", "RK4", "implicit"};
@@ -333,8 +367,7 @@ CaseResult run_case(const std::string& name, const std::string& scene,
         {"gravity_m_s2", {model->opt.gravity[0], model->opt.gravity[1], model->opt.gravity[2]}}}},
       {"parameters", params},
       {"metrics", metrics_json(m)},
-      {"mujoco_warnings", warning_total},
-      {"mujoco_warning_kinds", warnings},
+      {"mujoco_warnings", warnings},
       {"claims", claims},
       {"all_claims_pass", result.all_claims_pass},
       {"partial_claims", result.partial_claims},

@@ -8,10 +8,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "report/progress.h"
+#include "sim/mujoco_messages.h"
 #include "studies/claims.h"
 
 namespace vmh::studies {
@@ -78,6 +81,13 @@ void run_cases(std::vector<CaseJob>* jobs,
 // summary.json's pieces, for other writers of the same format (hw run)
 nlohmann::json claim_json(const Claim& c);
 nlohmann::json metrics_json(const RunMetrics& m);
+// summary.json's "mujoco_warnings": {count, kinds, messages}: the per-step
+// warnings by kind (ClosedLoop::mujoco_warning_counts) plus what else
+// MuJoCo said, and every text MuJoCo wrote, deduplicated
+// (sim/mujoco_messages.h; docs/outputs.md)
+nlohmann::json mujoco_warnings_json(
+    const std::array<std::int64_t, mjNWARNING>& per_step,
+    const sim::MujocoWarningTally& messages);
 
 // The trace's column names, in order.
 std::vector<std::string> trace_columns(int vm_dof);

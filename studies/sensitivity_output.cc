@@ -452,7 +452,7 @@ report::ChartGrid sensitivity_chart(const SweepPlan& plan,
       }
       report::ChartSeries zero;
       zero.label = "holds above 0";
-      zero.x = {0.5, plan.parameters.size() + 0.5};
+      zero.x = {0.5, static_cast<double>(plan.parameters.size()) + 0.5};
       zero.y = {0.0, 0.0};
       zero.color = "#000000";
       zero.dashed = true;

@@ -99,6 +99,7 @@ std::vector<RenderedImage> render(const RenderRequest& req) {
     // controller's output (the overlay) exists
     while (!ticked || loop.time_s() < t - 1e-9) {
       loop.tick(&row);
+      loop.throw_if_physics_fault();  // a picture of a reset state says nothing
       ticked = true;
     }
     const auto start = std::chrono::steady_clock::now();

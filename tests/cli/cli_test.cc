@@ -158,6 +158,26 @@ TEST(CliErrors, NegativeNumbersAreAccepted) {
   EXPECT_DOUBLE_EQ(json::parse(r.out)["q_dh"][0].get<double>(), -0.1);
 }
 
+// strtod sets ERANGE for a subnormal result too: such a number was refused
+// as "not a finite number"; an overflow to inf still is (issue 17)
+TEST(CliErrors, SubnormalNumbersAreAccepted) {
+  const CliRun r = run("kin fk --q 1e-320,0.2,0.3,0.4,0.5,0.6");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(json::parse(r.out)["q_dh"][0].get<double>(), 1e-320);
+  expect_usage_error("kin fk --q 1e999,0.2,0.3,0.4,0.5,0.6",
+                     "item 1 '1e999' is not a finite number");
+}
+
+// CLI11 reads an empty value of a numeric option as 0, which for most
+// options is their default: refused instead, on every verb
+TEST(CliErrors, AnEmptyNumberIsRefused) {
+  expect_usage_error("study stability --mass '' --damping 2",
+                     "--mass: the value is empty");
+  expect_usage_error("run case1 --jobs ''", "--jobs: the value is empty");
+  expect_usage_error("run case1 --duration ' '", "--duration");
+  expect_usage_error("ctl --ticks '' --q 0,0,0,0,0,0", "--ticks");
+}
+
 TEST(CliHelp, HelpExitsZero) {
   const CliRun r = run("--help");
   EXPECT_EQ(r.exit_code, 0);

@@ -488,6 +488,30 @@ TEST(CtlErrors, NonFiniteJointIsAFaultWithZeroForce) {
   }
 }
 
+// |F|^2 overflows (K_pos 1e155 N/mm, ~3 mm off the circle): a numerical
+// fault with zero force, not a zero force flagged force_saturated (issue 17)
+TEST(CtlErrors, AnOverflowingForceIsANumericalFault) {
+  const CliRun r = run("ctl --kpos 1e155 " + kPivotArg + " " + q_arg(case1_q()));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  ASSERT_FALSE(r.out.empty()) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["status"], json::array({"numerical_fault"})) << r.out;
+  EXPECT_EQ(j["status_code"], kStatusNumericalFault);
+  EXPECT_EQ(vec3(j["force_device_N"]), Vec3::Zero());
+  EXPECT_EQ(vec3(j["tau_Nm"]), Vec3::Zero());
+  EXPECT_EQ(vec3(j["tau_motor_Nm"]), Vec3::Zero());
+  EXPECT_NE(r.err.find("numerical_fault"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("force_saturated"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;
+}
+
+// strtod's ERANGE for a subnormal result is no reason to refuse it
+TEST(CtlOptions, SubnormalNumbersAreNumbers) {
+  const json j = ctl("--kpos 1e-320 --q 1e-320,0.1,0.2,0,0,0");
+  EXPECT_EQ(j["q_dh"][0].get<double>(), 1e-320);
+  EXPECT_EQ(j["gains"]["k_pos_N_per_mm"].get<double>(), 1e-320);
+}
+
 TEST(CtlHelp, TopLevelHelpListsCtl) {
   const CliRun r = run("--help");
   EXPECT_EQ(r.exit_code, 0);

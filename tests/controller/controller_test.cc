@@ -475,6 +475,38 @@ TEST(Faults, NonFiniteJointAnglesGiveZeroForceAndAFault) {
   EXPECT_LT((out.force_device_N - again.force_device_N).norm(), 1e-9);
 }
 
+// A force so large that |F|^2 overflows (K_pos 1e154 N/mm, 10 mm off the
+// circle: |F| ~ 1e155 N) is a numerical fault with zero force, not a
+// saturation: F / |F| was 0 and the zero force was reported as
+// force_saturated (issue 17). Just below the overflow it saturates properly.
+TEST(Faults, AnOverflowingForceIsANumericalFaultNotASaturation) {
+  const Joints q = pose_q(on_circle(0.4, 60.0), Vec3(0.3, 0.1, 1));
+  ControllerParams p = thesis_case(1);
+  p.force_limit_N = 3.3;
+  p.omni.motor_torque_limit_Nm = {10, 10, 10};
+  p.gains.k_pos_N_per_mm = 1e154;
+  Controller c(p);
+  ControlOutput out;
+  const ControlStatus st = c.tick(q, &out);
+  EXPECT_TRUE(st & kStatusNumericalFault) << st;
+  EXPECT_FALSE(st & kStatusForceSaturated) << st;
+  EXPECT_FALSE(st & kStatusTorqueSaturated) << st;
+  EXPECT_TRUE(is_fault(st));
+  EXPECT_EQ(out.status, st);
+  EXPECT_EQ(out.force_device_N, Vec3::Zero());
+  EXPECT_EQ(out.force_base_N, Vec3::Zero());
+  EXPECT_EQ(out.tau_dh_Nm, Vec3::Zero());
+  EXPECT_EQ(out.tau_motor_Nm, Vec3::Zero());
+
+  p.gains.k_pos_N_per_mm = 1e150;  // |F| ~ 1e151 N: |F|^2 still finite
+  const ControlOutput big = tick_once(p, q);
+  EXPECT_FALSE(is_fault(big.status));
+  EXPECT_TRUE(big.status & kStatusForceSaturated);
+  EXPECT_GT(big.force_device_N.norm(), 0.0);
+  EXPECT_LE(big.force_device_N.norm(), 3.3 + 1e-12);
+  EXPECT_LT(angle_between(big.force_device_N, big.f_motion.head<3>()), 1e-9);
+}
+
 void expect_finite(const ControlOutput& out) {
   EXPECT_TRUE(out.f_motion.allFinite());
   EXPECT_TRUE(out.e.allFinite());

@@ -446,7 +446,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadValue{text_field("fault", "jump") + numeric_field("fault_joint", "4"),
                  "fault_joint"},
         num("fault_joint", "7"), num("servo_jitter_s", "0.002 0.001"),
-        num("servo_jitter_s", "0 0.001"), txt("fault", "drift")));
+        num("servo_jitter_s", "0 0.001"), txt("fault", "drift"),
+        // the bounds that keep a run's counts in range (issue 17)
+        num("servo_period_s", "3e6"), num("servo_period_s", "1e-6"),
+        num("duration_s", "1e308"), num("duration_s", "3601"),
+        num("physics_step_s", "1.5"), num("servo_jitter_s", "0.0004 1e12"),
+        num("servo_jitter_s", "-0.001 0.001")));
 
 // The edges of the ranges are accepted.
 TEST_F(CaseConfigTest, RangeEdgesAreAccepted) {
@@ -454,7 +459,12 @@ TEST_F(CaseConfigTest, RangeEdgesAreAccepted) {
        {numeric_field("delay_ticks", "0"), numeric_field("delay_ticks", "64"),
         numeric_field("quantize", "0"), numeric_field("thesis_case", "6"),
         numeric_field("k_pos_N_per_mm", "0"),
-        numeric_field("placement_weights", "0 0 0 0 0 0")}) {
+        numeric_field("placement_weights", "0 0 0 0 0 0"),
+        numeric_field("servo_period_s", "1e-5"),
+        numeric_field("servo_period_s", "1"),
+        numeric_field("duration_s", "3600"),
+        numeric_field("physics_step_s", "1"),
+        numeric_field("servo_jitter_s", "1 1")}) {
     EXPECT_NO_THROW(load(kCircle + customs)) << customs;
   }
   for (const char* kind : {"circle", "sphere", "surface"}) {
@@ -692,6 +702,43 @@ TEST(CaseParamTable, DocsAreTheGeneratedTable) {
               std::string::npos)
         << f.name;
   }
+}
+
+// The bounds are the table's (so `vmhaptics params` shows them), and a
+// refusal names where the value came from, the field, the range and the
+// value as %g: 1e-7 is "1e-07", not std::to_string's "0.000000".
+TEST(CaseParamTable, BoundsAreInTheTableAndItsMessages) {
+  const ParamSpec& duration = *find_param("duration_s");
+  EXPECT_EQ(duration.range_text(), "> 0 and <= 3600");
+  EXPECT_EQ(find_param("servo_period_s")->range_text(), "in [1e-05, 1]");
+  const std::string steps = std::to_string(kMaxSubstepsPerTick);
+  EXPECT_EQ(find_param("physics_step_s")->range_text(),
+            ">= 0 and <= 1; servo_period_s / h a whole number in [1, " +
+                steps + "]");
+  EXPECT_EQ(find_param("servo_jitter_s")->range_text(),
+            "each >= 0 and <= 1; 0 0, or 0 < min <= max; max / the physics "
+            "step <= " + steps);
+  EXPECT_EQ(find_param("delay_ticks")->range_text(),
+            "a whole number in [0, 64]");
+
+  const auto message = [](const char* name, double x) {
+    try {
+      check_param_number(*find_param(name), x, "--where");
+    } catch (const ParamError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message("duration_s", 1e308),
+            "--where: field 'duration_s' must be > 0 and <= 3600, got 1e+308");
+  EXPECT_EQ(message("duration_s", -1e-7),
+            "--where: field 'duration_s' must be > 0 and <= 3600, got -1e-07");
+  EXPECT_EQ(message("duration_s", std::nan("")),
+            "--where: field 'duration_s' must be > 0 and <= 3600, got nan");
+  EXPECT_EQ(message("servo_period_s", 3e6),
+            "--where: field 'servo_period_s' must be in [1e-05, 1], got 3000000");
+  EXPECT_EQ(message("duration_s", 1e-7), "");  // one tick: ClosedLoop's check
+  EXPECT_EQ(message("vm_pivot_mm", -1e300), "");  // kAny
 }
 
 }  // namespace

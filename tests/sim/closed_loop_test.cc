@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -40,6 +41,8 @@ TEST_P(CaseTest, RunsWithoutWarningOrFault) {
   }
   EXPECT_EQ(testing::MujocoGuard::data_warnings(loop.data()), "");
   EXPECT_EQ(testing::MujocoGuard::warnings(), "");
+  EXPECT_FALSE(loop.physics_fault().has_value());
+  for (std::int64_t n : loop.mujoco_warning_counts()) EXPECT_EQ(n, 0);
   EXPECT_EQ(faults, 0);
   for (int i = 0; i < loop.model()->nq; ++i) {
     EXPECT_TRUE(std::isfinite(loop.data()->qpos[i]));
@@ -302,6 +305,114 @@ TEST(ClosedLoopTest, ManualTargetPullsTheGrip) {
   EXPECT_NEAR((row.hand_target.p_mm - loop.script().at(row.t_s).p_mm).norm(),
               0.0, 1e-12);
   EXPECT_GT((loop.hand().target().p_m - target.p_m).norm(), 0.01);
+}
+
+// ---- the bounds on a run's counts, checked before any work (issue 17) ----
+
+constexpr auto npos = std::string::npos;
+
+// the message of the SimError that making case 1's loop throws; "" if none
+std::string refusal(const std::vector<std::string>& sets,
+                    const ModelHook& hook = {}) {
+  try {
+    ClosedLoop loop(scene(1), sets, hook);
+  } catch (const SimError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// T / h must fit kMaxSubstepsPerTick: 1e-3 s / 1e-300 s was an int cast of
+// 1e297 (undefined behaviour) before
+TEST(ClosedLoopBounds, RefusesTooManyPhysicsStepsPerTick) {
+  const std::string msg = refusal({"physics_step_s=1e-300"});
+  EXPECT_NE(msg.find("servo_period_s / physics_step_s (0.001 s / 1e-300 s)"),
+            npos) << msg;
+  EXPECT_NE(msg.find("[1, 1000000]"), npos) << msg;
+  EXPECT_NE(msg.find("got 1e+297"), npos) << msg;
+  EXPECT_EQ(refusal({"physics_step_s=1e-9"}), "");   // 1e6 steps: the bound
+  EXPECT_NE(refusal({"physics_step_s=5e-10"}), "");  // 2e6
+  // a step longer than the period
+  EXPECT_NE(refusal({"physics_step_s=0.003"}).find("[1, 1000000]"), npos);
+}
+
+// the scene's own step (physics_step_s 0 keeps it) must be finite and > 0:
+// timestep="0" made T / h infinite
+TEST(ClosedLoopBounds, RefusesASceneStepThatIsNotFiniteAndPositive) {
+  for (const double h : {0.0, -0.001, std::nan(""), HUGE_VAL}) {
+    const std::string msg =
+        refusal({}, [h](mjModel* m) { m->opt.timestep = h; });
+    EXPECT_NE(msg.find("the scene's <option timestep> must be finite and > 0"),
+              npos) << h << ": " << msg;
+  }
+}
+
+// the jitter's longest period in physics steps: 0.9 s at a 1e-7 s step is
+// 9e6 steps in one tick
+TEST(ClosedLoopBounds, RefusesAJitterPeriodOfTooManySteps) {
+  const std::string msg =
+      refusal({"physics_step_s=1e-7", "servo_jitter_s=0.0004,0.9"});
+  EXPECT_NE(msg.find("servo_jitter_s's longest period"), npos) << msg;
+  EXPECT_NE(msg.find("at most 1000000 physics steps, got 9000000"), npos) << msg;
+}
+
+// a run must last at least one servo tick, and says so with the value as
+// %g (1e-07, not 0.000000)
+TEST(ClosedLoopBounds, RefusesARunShorterThanOneTick) {
+  const std::string msg = refusal({"duration_s=1e-7"});
+  EXPECT_NE(msg.find("duration_s (1e-07 s) must last from 1 to 1000000000 "
+                     "servo periods (servo_period_s = 0.001 s), got 0.0001"),
+            npos) << msg;
+  EXPECT_EQ(refusal({"duration_s=0.0006"}), "");  // rounds to one tick
+}
+
+// the longest run the table allows at its shortest period: 3.6e8 ticks,
+// counted in 64 bits
+TEST(ClosedLoopBounds, CountsTheLongestRunInAWideType) {
+  ClosedLoop loop(scene(1), {"duration_s=3600", "servo_period_s=1e-5",
+                             "physics_step_s=1e-5"});
+  EXPECT_EQ(loop.ticks_per_run(), std::int64_t{360000000});
+  EXPECT_EQ(loop.substeps(), 1);
+}
+
+// ---- a physics state gone bad (issue 17) ----
+
+// A hand 1e30 N/m stiff: the first physics step's qacc is beyond MuJoCo's
+// 1e10; mj_step warns, resets the state and would carry on (here to blow
+// up again at every step). The loop keeps the first bad step and counts
+// every one, though each reset set MuJoCo's own counter back to 1.
+TEST(ClosedLoopPhysics, TheFirstBadStateIsKeptAndEveryWarningCounted) {
+  testing::MujocoGuard guard;  // MuJoCo's messages to the guard
+  ClosedLoop loop(scene(1), {"hand_k_pos_N_per_m=1e30"});
+  EXPECT_FALSE(loop.physics_fault().has_value());
+  EXPECT_NO_THROW(loop.throw_if_physics_fault());
+  TraceRow row;
+  loop.tick(&row);
+  ASSERT_TRUE(loop.physics_fault().has_value());
+  const PhysicsFault first = *loop.physics_fault();
+  EXPECT_DOUBLE_EQ(first.t_s, 0.001);
+  EXPECT_EQ(first.part, "qacc");
+  EXPECT_GE(first.index, 0);
+  EXPECT_EQ(first.message(), "physics went non-finite at t=0.001 s (qacc, DOF " +
+                                 std::to_string(first.index) + ")");
+  EXPECT_FALSE(row.state_finite);
+  try {
+    loop.throw_if_physics_fault();
+    ADD_FAILURE() << "no PhysicsError";
+  } catch (const PhysicsError& e) {
+    EXPECT_EQ(std::string(e.what()), scene(1) + ": " + first.message());
+  }
+  // tick() itself goes on (a study may look further), keeping the first
+  // fault and counting each bad step across MuJoCo's resets
+  const std::int64_t after_one = loop.mujoco_warning_counts()[mjWARN_BADQACC];
+  EXPECT_GE(after_one, 1);
+  for (int k = 0; k < 3; ++k) loop.tick(&row);
+  EXPECT_GT(loop.mujoco_warning_counts()[mjWARN_BADQACC], after_one);
+  EXPECT_DOUBLE_EQ(loop.physics_fault()->t_s, 0.001);
+  // reset() starts clean
+  loop.reset();
+  EXPECT_FALSE(loop.physics_fault().has_value());
+  for (std::int64_t n : loop.mujoco_warning_counts()) EXPECT_EQ(n, 0);
 }
 
 }  // namespace

@@ -87,7 +87,9 @@ TEST(OmniModelEdit, ScalesMassesFrictionDampingAndGains) {
   for (int b = 0; b < m->nbody; ++b) {
     bool omni = false;
     for (const char* n : kOmniBodies) omni |= mj_name2id(m.get(), mjOBJ_BODY, n) == b;
-    if (!omni) EXPECT_EQ(m->body_mass[b], ref->body_mass[b]) << "body " << b;
+    if (!omni) {
+      EXPECT_EQ(m->body_mass[b], ref->body_mass[b]) << "body " << b;
+    }
   }
   EXPECT_EQ(omni_edit_text(e),
             "mass_scale=2,damping_scale=0.5,friction_scale=3,motor_gain2=-1,"
