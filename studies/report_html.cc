@@ -372,7 +372,7 @@ std::string report_html(const ReportInputs& in) {
                        escape(list_text(tally.failed)) + "</span>") +
        (tally.partial.empty()
             ? std::string()
-            : " &#8212; holding on one side of the pivot only: " +
+            : " &#8212; holding in part (each one's holds_where says where): " +
                   escape(list_text(tally.partial))) +
        "</p>\n";
   s += "<ul>\n";

@@ -77,7 +77,8 @@ struct ClaimTally {
   int passed = 0;
   int total = 0;
   std::vector<std::string> failed;  // "case:claim"
-  // held on some sides of the pivot only ("pass": "partial"), "case:claim";
+  // held on some sides only (of the pivot, or far off the path and not near
+  // it; "pass": "partial"), "case:claim";
   // counted in total, neither passed nor failed
   std::vector<std::string> partial;
 };
