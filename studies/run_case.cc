@@ -244,7 +244,6 @@ std::vector<double> field_numbers(const ClosedLoop& loop, const char* name) {
   return {};
 }
 
-
 }  // namespace
 
 CaseResult run_case(const std::string& name, const std::string& scene,
