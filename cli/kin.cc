@@ -131,6 +131,16 @@ void run_ik(const KinOptions& o) {
   const Joints near = o.near.empty()
                           ? Joints::Zero().eval()
                           : read_joints("--near", o.near, o.convention);
+  for (int i = 0; i < kOmniJoints; ++i) {
+    if (std::abs(near[i]) > kIkMaxHintRad) {
+      char msg[160];
+      std::snprintf(msg, sizeof msg,
+                    "--near: q%d = %g rad is beyond +-%g rad, where whole "
+                    "turns can no longer be told apart",
+                    i + 1, near[i], kIkMaxHintRad);
+      throw UsageError(msg);
+    }
+  }
   const IkSolutions s =
       o.R_base.empty()
           ? omni_ik_position(p, target_base_m, near)

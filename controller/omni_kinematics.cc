@@ -247,7 +247,8 @@ const char* ik_status_name(IkStatus s) {
 IkSolutions omni_ik_position(const OmniParams& params, const Vec3& p,
                              const Joints& near) {
   IkSolutions out;
-  if (!p.allFinite() || !near.allFinite()) {
+  if (!p.allFinite() || !near.allFinite() ||
+      near.cwiseAbs().maxCoeff() > kIkMaxHintRad) {
     out.status = IkStatus::kInvalidInput;
     return out;
   }

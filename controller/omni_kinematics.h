@@ -96,8 +96,14 @@ OmniArmKinematics omni_arm_kinematics(const OmniParams& params,
 enum class IkStatus {
   kOk = 0,
   kUnreachable,   // no joint angles put the wrist centre there
-  kInvalidInput,  // a non-finite target or hint
+  kInvalidInput,  // a non-finite target or hint, or a hint beyond kIkMaxHintRad
 };
+
+// The largest |angle| of an IK hint (`near`), rad. Solutions are shifted by
+// whole turns to lie within pi of the hint, and beyond about 1e4 rad that
+// shift loses the angle to rounding (near 1e17 rad a double cannot hold an
+// angle at all), so a larger hint is refused as invalid input.
+inline constexpr double kIkMaxHintRad = 1e4;
 
 const char* ik_status_name(IkStatus status);
 

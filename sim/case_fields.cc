@@ -222,11 +222,15 @@ const std::vector<ParamSpec>& case_fields() {
           .in_range(1e-5, 1.0)
           .ctl("--servo-period-s"),
       numeric("controller", "force_limit_N", 1, "3.3", "N",
-              "force saturation (Omni peak)",
+              "force saturation; at most the Omni's rated peak, which a "
+              "larger limit would only hand on to the motors' clamps",
               [](CaseParams* p, const ParamValue& v) {
                 p->controller.force_limit_N = item(v);
               })
           .positive()
+          .at_most(3.3)
+          .source("the PHANTOM Omni's rated peak force at the nominal pose "
+                  "(docs/sources.md, 7)")
           .ctl("--force-limit-N"),
       text("controller", "torque_limits", "openhaptics_samples",
            "openhaptics_samples, rated",

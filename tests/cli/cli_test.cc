@@ -143,6 +143,10 @@ TEST(CliErrors, BadInputIsOneLineNamingTheProblem) {
   expect_usage_error("kin fk --q 0,0,0,0,0,0 --convention xyz", "--convention");
   expect_usage_error("kin ik", "--p-device-mm");
   expect_usage_error("kin ik --p-device-mm 1,2", "--p-device-mm: expected 3");
+  // a hint so large that whole turns cannot be told apart (it returned
+  // "ok" with q1 = 1e17, 86 mm from the target)
+  expect_usage_error("kin ik --p-device-mm 0,-65.51,-88.11 --near 1e17,0,0,0,0,0",
+                     "--near: q1 = 1e+17 rad is beyond");
   expect_usage_error("kin ik --p-device-mm 0,0,0 --R-base 1,0,0,0,1,0,0,0,2",
                      "--R-base");
   expect_usage_error("kin jac --q 0,0,0,0,0,0 --tool-offset-mm abc",

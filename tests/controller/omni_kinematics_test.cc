@@ -259,6 +259,18 @@ TEST(OmniIk, NonFiniteInputIsRejected) {
   near[4] = INFINITY;
   EXPECT_EQ(omni_ik_position(p, Vec3(0.1, 0, 0), near).status,
             IkStatus::kInvalidInput);
+  // a finite hint too large to unwrap toward (1e17 rad has no angle left)
+  near = Joints::Zero();
+  near[0] = 1e17;
+  EXPECT_EQ(omni_ik_position(p, Vec3(0.1, 0, 0), near).status,
+            IkStatus::kInvalidInput);
+  near[0] = kIkMaxHintRad;  // the largest accepted
+  const IkSolutions big = omni_ik_position(p, Vec3(0.1, 0, -0.1), near);
+  ASSERT_EQ(big.status, IkStatus::kOk);
+  for (int k = 0; k < big.count; ++k) {
+    const OmniPose fk = omni_fk(p, big.q_dh[k]);
+    EXPECT_LT((fk.p_base_m - Vec3(0.1, 0, -0.1)).norm(), 1e-9) << k;
+  }
   Mat3 R = Mat3::Identity();
   R(1, 1) = nan;
   const IkSolutions s = omni_ik_pose(p, Vec3(0.1, 0, -0.1), R, Joints::Zero());

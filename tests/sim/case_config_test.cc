@@ -267,6 +267,17 @@ TEST_F(CaseConfigTest, SceneSetsFrictionUnilateralAndOrientationDamping) {
   EXPECT_EQ(controller_params(kv).gains.k_vel_ornt_Nmms_per_rad, 0.0);
 }
 
+// the device's rated peak caps the force limit (1e6 was accepted and the
+// commanded force reached 3.55 N, bounded by the motors' clamps alone)
+TEST_F(CaseConfigTest, ForceLimitIsCappedAtTheRatedPeak) {
+  EXPECT_NO_THROW(load(kCircle, {"force_limit_N=3.3"}));
+  for (const char* bad : {"force_limit_N=1e6", "force_limit_N=3.31"}) {
+    const std::string msg = load_error(kCircle, {bad});
+    EXPECT_TRUE(contains(msg, "'force_limit_N'")) << bad << ": " << msg;
+    EXPECT_TRUE(contains(msg, "3.3")) << bad << ": " << msg;
+  }
+}
+
 TEST_F(CaseConfigTest, OnlyFrictionMayBeInfinite) {
   EXPECT_NO_THROW(load(kCircle, {"friction_mu=inf"}));
   for (const char* bad : {"friction_mu=-inf", "friction_mu=nan",
