@@ -97,7 +97,7 @@ void BM_RunAll(benchmark::State& state) {
     std::vector<studies::CaseJob> jobs;
     for (const studies::CaseEntry& c : studies::thesis_cases()) {
       jobs.push_back(studies::CaseJob{c.name, case_scene(static_cast<int>(
-                                         jobs.size() + 1)), {}, {}, false});
+                                         jobs.size() + 1)), {}, {}, false, false});
     }
     studies::run_cases(&jobs, {}, "", 2);
     for (const studies::CaseJob& j : jobs) {

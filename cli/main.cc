@@ -12,7 +12,8 @@
 // Exit codes: 0 success, 2 bad usage or bad input (a device that cannot be
 // opened included), 1 any other failure (a run whose physics went
 // non-finite, a MuJoCo error), 128 + n when signal n (SIGINT, SIGTERM)
-// stopped an hw session (its trace is kept, zero torque sent).
+// stopped an hw session (its trace is kept, zero torque sent) or a run
+// (its complete output sets kept, the others removed).
 //
 // MuJoCo's own handlers are replaced first of all (sim/mujoco_messages.h):
 // its warnings are counted and printed on stderr, one line per kind, just

@@ -5,8 +5,14 @@
 // Prints a table of the error to the path against the run time (or, with
 // --json, one JSON object holding every case's summary), and writes
 // DIR/<case>/trace.csv and DIR/<case>/summary.json when --out is given.
+// Each case's files are written as one set (studies/run_case.h): a reader of
+// DIR/<case> sees the previous whole set or the new one, never a mix.
 // Exit codes: 0 every run finished and every claim passed; 1 a claim failed
-// or a run failed; 2 bad usage or bad input (nothing is written for it).
+// or a run failed (a set that could not be written included: it is not
+// left half-written); 2 bad usage or bad input (nothing is written for it),
+// an --out that cannot be created or written in included (found before any
+// run); 130 / 143 SIGINT / SIGTERM (the sets not yet complete are removed,
+// the complete ones kept).
 #include "cli/run.h"
 
 #include <algorithm>
@@ -15,6 +21,9 @@
 #include <iostream>
 
 #include "cli/args.h"
+#include "cli/hw_common.h"
+#include "device/stop_signal.h"
+#include "report/output_file.h"
 #include "report/progress.h"
 #include "sim/case_params.h"
 #include "studies/run_case.h"
@@ -112,24 +121,57 @@ void run(const RunOptions& o) {
     }
     model = std::filesystem::absolute(o.model, ec).string();
   }
+  // an --out that cannot hold the sets is found before any run
+  if (!o.out.empty()) {
+    try {
+      report::check_writable_dir(o.out);
+    } catch (const std::exception& e) {
+      throw UsageError(std::string("run: --out ") + e.what());
+    }
+  }
   std::vector<studies::CaseJob> runs;
   for (const auto& [name, scene] : jobs) {
-    runs.push_back(studies::CaseJob{name, scene, {}, {}, false});
+    runs.push_back(studies::CaseJob{name, scene, {}, {}, false, false});
   }
   {
-    // a bar on stderr (terminal only) for --all; one case is one item
-    report::Progress bar("run", runs.size());
-    studies::run_cases(&runs, sets, o.out, o.jobs, model,
-                       o.all ? bar.part(0) : report::ProgressFn{});
+    // SIGINT / SIGTERM only set a flag (device/stop_signal.h); the runs poll
+    // it between ticks and before each file, and a stopped run's temporary
+    // set is removed by its own thread, outside the handler
+    StopSignals signals;
+    {
+      // a bar on stderr (terminal only) for --all; one case is one item
+      report::Progress bar("run", runs.size());
+      studies::run_cases(&runs, sets, o.out, o.jobs, model,
+                         o.all ? bar.part(0) : report::ProgressFn{},
+                         [&signals] { return signals.requested(); });
+    }
+    if (signals.requested()) {
+      const int signo = signals.signal_number();
+      std::string kept;
+      for (const studies::CaseJob& j : runs) {
+        if (j.error.empty() && !o.out.empty()) kept += " " + j.name;
+      }
+      throw SignalStop(std::string("interrupted: run stopped by ") +
+                           (signo == SIGINT ? "SIGINT" : "SIGTERM") +
+                           (o.out.empty() ? ""
+                            : kept.empty() ? "; no set written"
+                                           : "; complete sets kept:" + kept),
+                       signo);
+    }
   }
   std::vector<studies::CaseResult> results;
+  std::string errors;  // every failed run, in one line
+  bool bad_input = false;
   for (const studies::CaseJob& j : runs) {
     if (!j.error.empty()) {
-      const std::string msg = "run " + j.name + ": " + j.error;
-      if (j.bad_input) throw UsageError(msg);
-      throw std::runtime_error(msg);
+      errors += (errors.empty() ? "run " : "; ") + j.name + ": " + j.error;
+      bad_input |= j.bad_input;
     }
     results.push_back(j.result);
+  }
+  if (!errors.empty()) {
+    if (bad_input) throw UsageError(errors);
+    throw std::runtime_error(errors);
   }
 
   if (o.json) {

@@ -1,46 +1,207 @@
 #include "report/output_file.h"
 
-#include <filesystem>
-#include <fstream>
-#include <system_error>
+#include <fcntl.h>
+#include <stdio.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <random>
 #include <stdexcept>
+#include <system_error>
+#include <vector>
 
 namespace vmh::report {
+namespace fs = std::filesystem;
+namespace {
+
+// "-<pid>-<n>": unique among this process's calls and other processes'
+std::string unique_suffix() {
+  static std::atomic<unsigned long> counter{0};
+  return "-" + std::to_string(static_cast<long>(getpid())) + "-" +
+         std::to_string(++counter);
+}
+
+std::string os_error(int err) { return std::strerror(err); }
+
+// writes `text` to a new file `path` (which must not exist), mode 0666 less
+// the umask; returns 0 or the errno of what failed (the file is removed)
+int write_new_file(const std::string& path, const std::string& text) {
+  const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) return errno;
+  const char* p = text.data();
+  std::size_t left = text.size();
+  int err = 0;
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      err = errno;
+      break;
+    }
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  if (close(fd) != 0 && err == 0) err = errno;
+  if (err != 0) unlink(path.c_str());
+  return err;
+}
+
+}  // namespace
 
 void write_file_atomically(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error(tmp + ": cannot open for writing");
-    out << text;
-    out.flush();
-    if (!out) {
-      out.close();
-      std::error_code ignored;
-      fs::remove(tmp, ignored);
-      throw std::runtime_error(tmp + ": write failed");
-    }
+  const std::string tmp = path + ".tmp" + unique_suffix();
+  if (const int err = write_new_file(tmp, text)) {
+    throw std::runtime_error(path + ": " + os_error(err));
   }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw std::runtime_error(path + ": " + ec.message());
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    unlink(tmp.c_str());
+    throw std::runtime_error(path + ": " + os_error(err));
   }
 }
 
 std::string write_file_in(const std::string& dir, const std::string& name,
                           const std::string& text) {
-  namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error(dir + ": " + ec.message());
   const std::string path = (fs::path(dir) / name).string();
   write_file_atomically(path, text);
   return path;
+}
+
+void check_writable_dir(const std::string& dir) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(dir, ec);
+  if (fs::exists(st) && !fs::is_directory(st)) {
+    throw std::runtime_error(dir + ": " + os_error(ENOTDIR));
+  }
+  // the folders this check makes, deepest first, to be taken away again:
+  // a run refused later for bad input leaves nothing behind
+  std::vector<fs::path> made;
+  for (fs::path p = fs::path(dir); !p.empty() && !fs::exists(fs::symlink_status(p, ec));
+       p = p.parent_path()) {
+    made.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  const auto unmake = [&made] {
+    // rmdir only: a folder another run has written in meanwhile stays
+    for (const fs::path& p : made) rmdir(p.c_str());
+  };
+  fs::create_directories(dir, ec);
+  if (ec) {
+    unmake();
+    throw std::runtime_error(dir + ": " + ec.message());
+  }
+  std::string probe = (fs::path(dir) / ".vmh-probe-XXXXXX").string();
+  const int fd = mkstemp(probe.data());
+  if (fd < 0) {
+    const int err = errno;
+    unmake();
+    throw std::runtime_error(dir + ": " + os_error(err));
+  }
+  close(fd);
+  unlink(probe.c_str());
+  unmake();
+}
+
+OutputSet::OutputSet(const std::string& dest) : dest_(dest) {
+  const fs::path d(dest);
+  const fs::path parent = d.has_parent_path() ? d.parent_path() : fs::path(".");
+  std::error_code ec;
+  fs::create_directories(parent, ec);
+  if (ec) throw std::runtime_error(parent.string() + ": " + ec.message());
+  std::string templ = (parent / ("." + d.filename().string() + ".tmp-" +
+                                 std::to_string(static_cast<long>(getpid())) +
+                                 "-XXXXXX"))
+                          .string();
+  if (mkdtemp(templ.data()) == nullptr) {
+    throw std::runtime_error(parent.string() + ": " + os_error(errno));
+  }
+  // mkdtemp makes it 0700; the set's folder gets a folder's usual mode
+  const mode_t mask = 022;
+  chmod(templ.c_str(), 0777 & ~mask);
+  tmp_ = templ;
+}
+
+OutputSet::~OutputSet() {
+  if (!committed_ && !tmp_.empty()) {
+    std::error_code ignored;
+    fs::remove_all(tmp_, ignored);
+  }
+}
+
+void OutputSet::write(const std::string& name, const std::string& text) {
+  const std::string path = (fs::path(tmp_) / name).string();
+  if (const int err = write_new_file(path, text)) {
+    throw std::runtime_error((fs::path(dest_) / name).string() + ": " + os_error(err));
+  }
+}
+
+void OutputSet::commit() {
+  // another run may put its set in place between any two steps: retry
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    // no set there yet: a plain rename (it fails if another run's set
+    // arrived meanwhile)
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(dest_, ec))) {
+      if (std::rename(tmp_.c_str(), dest_.c_str()) == 0) {
+        committed_ = true;
+        return;
+      }
+      if (errno != ENOTEMPTY && errno != EEXIST) break;
+      continue;
+    }
+#ifdef RENAME_EXCHANGE
+    if (renameat2(AT_FDCWD, tmp_.c_str(), AT_FDCWD, dest_.c_str(),
+                  RENAME_EXCHANGE) == 0) {
+      // tmp_ holds the previous set now
+      committed_ = true;
+      std::error_code ignored;
+      fs::remove_all(tmp_, ignored);
+      return;
+    }
+    if (errno == ENOENT) continue;  // removed meanwhile
+    if (errno != EINVAL && errno != ENOSYS && errno != EOPNOTSUPP) break;
+#endif
+    // no atomic exchange on this file system: the previous set aside to a
+    // private name, the new one in, the previous one removed
+    const fs::path d(dest_);
+    std::string aside =
+        (d.parent_path() / ("." + d.filename().string() + ".old-" +
+                            std::to_string(static_cast<long>(getpid())) + "-XXXXXX"))
+            .string();
+    if (mkdtemp(aside.data()) == nullptr) break;
+    if (std::rename(dest_.c_str(), aside.c_str()) != 0) {
+      const int err = errno;
+      rmdir(aside.c_str());
+      if (err == ENOENT) continue;
+      errno = err;
+      break;
+    }
+    const bool in = std::rename(tmp_.c_str(), dest_.c_str()) == 0;
+    const int err = errno;
+    std::error_code ignored;
+    fs::remove_all(aside, ignored);
+    if (in) {
+      committed_ = true;
+      return;
+    }
+    if (err != ENOTEMPTY && err != EEXIST) {
+      errno = err;
+      break;
+    }
+  }
+  const int err = errno;
+  std::error_code ignored;
+  fs::remove_all(tmp_, ignored);
+  tmp_.clear();
+  throw std::runtime_error(dest_ + ": " + os_error(err != 0 ? err : EBUSY));
 }
 
 }  // namespace vmh::report

@@ -7,9 +7,12 @@
 
 namespace vmh::report {
 
-// Writes `text` to `path` through "<path>.tmp" and a rename (atomic on one
-// file system): readers see the old file or the whole new one. Throws
-// std::runtime_error naming the path when it cannot open, write or rename.
+// Writes `text` to `path` through a temporary file beside it, named
+// "<path>.tmp-<pid>-<n>" (unique per process and per call, so two processes
+// writing the same path never share one), and a rename (atomic on one file
+// system): readers see the old file or the whole new one. Throws
+// std::runtime_error naming the path and the OS error when it cannot open,
+// write or rename; the temporary file is removed.
 void write_file_atomically(const std::string& path, const std::string& text);
 
 // Creates `dir` if needed and writes dir/name as write_file_atomically does.
@@ -17,6 +20,45 @@ void write_file_atomically(const std::string& path, const std::string& text);
 // the path.
 std::string write_file_in(const std::string& dir, const std::string& name,
                           const std::string& text);
+
+// Checks that `dir` is a folder this process can write in: creates it (and
+// its parents) if needed, creates and removes a probe file in it, then
+// removes the folders it created (the writers create them again), so that
+// the check itself leaves nothing. Throws std::runtime_error "<dir>: <the
+// OS's reason>" (e.g. "Not a directory", "Permission denied") otherwise.
+void check_writable_dir(const std::string& dir);
+
+// A folder's files written as one set: they go into a private temporary
+// folder beside `dest` (".<name>.tmp-<pid>-XXXXXX", made as mkdtemp makes
+// it), and commit() renames that folder to `dest` once every file is
+// complete. An existing `dest` is swapped for the new one at once (Linux's
+// renameat2 RENAME_EXCHANGE; else moved aside to a private name first) and
+// then removed: a reader sees the previous whole set or the new whole set,
+// never a mix. Without commit() (an error, an interrupt) the destructor
+// removes the temporary folder and `dest` is left as it was.
+class OutputSet {
+ public:
+  // Creates dest's parent if needed and the temporary folder. Throws
+  // std::runtime_error naming the folder and the OS error.
+  explicit OutputSet(const std::string& dest);
+  ~OutputSet();  // removes the temporary folder unless committed
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+
+  // Writes dest/name (in the temporary folder for now). Throws
+  // std::runtime_error "dest/name: <the OS's reason>".
+  void write(const std::string& name, const std::string& text);
+  // Puts the set in place of `dest`. Throws std::runtime_error naming dest
+  // and the OS error (the temporary folder is removed then too).
+  void commit();
+
+  const std::string& temp_dir() const { return tmp_; }
+
+ private:
+  std::string dest_;
+  std::string tmp_;
+  bool committed_ = false;
+};
 
 }  // namespace vmh::report
 

@@ -206,7 +206,7 @@ namespace {
 
 // the loop to its end, with the reference controller where the case's
 // claims compare with case 2's gains
-std::vector<TraceRow> run_to_end(ClosedLoop* loop) {
+std::vector<TraceRow> run_to_end(ClosedLoop* loop, const StopFn& stop) {
   const int thesis_case = loop->config().thesis_case;
   if (auto ref = reference_params(thesis_case, loop->controller_params())) {
     loop->set_reference(*ref);
@@ -229,6 +229,7 @@ std::vector<TraceRow> run_to_end(ClosedLoop* loop) {
   // a bad physics state (NaN, inf or beyond 1e10, which MuJoCo resets)
   // ends the run at the end of its tick: a failure (exit 1), not a result
   while (!loop->finished()) {
+    if (stop && stop()) throw Interrupted();
     rows.emplace_back();
     loop->tick(&rows.back());
     loop->throw_if_physics_fault();
@@ -249,7 +250,7 @@ std::vector<double> field_numbers(const ClosedLoop& loop, const char* name) {
 CaseResult run_case(const std::string& name, const std::string& scene,
                     const std::vector<std::string>& overrides,
                     const std::string& out_dir,
-                    const std::string& model_file) {
+                    const std::string& model_file, const StopFn& should_stop) {
   CaseResult result;
   result.name = name;
   result.scene = scene;
@@ -259,7 +260,7 @@ CaseResult run_case(const std::string& name, const std::string& scene,
   ClosedLoop loop(scene, overrides, omni_model_hook(model_file));
   const int thesis_case = loop.config().thesis_case;
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<TraceRow> rows = run_to_end(&loop);
+  const std::vector<TraceRow> rows = run_to_end(&loop, should_stop);
   const auto stop = std::chrono::steady_clock::now();
   result.wall_time_s = std::chrono::duration<double>(stop - start).count();
   result.simulated_s = loop.time_s();
@@ -278,7 +279,7 @@ CaseResult run_case(const std::string& name, const std::string& scene,
       std::vector<std::string> o = overrides;
       o.insert(o.end(), extra.begin(), extra.end());
       ClosedLoop l(scene, o, omni_model_hook(model_file));
-      const std::vector<TraceRow> r = run_to_end(&l);
+      const std::vector<TraceRow> r = run_to_end(&l, should_stop);
       return evaluate_claims(thesis_case, r, l);
     };
     const auto number = [](const char* field, double v) {
@@ -373,14 +374,19 @@ CaseResult run_case(const std::string& name, const std::string& scene,
   };
 
   if (!out_dir.empty()) {
-    const fs::path dir = fs::path(out_dir) / name;
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw SimError(dir.string() + ": " + ec.message());
-    report::write_file_atomically((dir / "trace.csv").string(), trace_csv(rows, loop));
-    report::write_file_atomically((dir / "summary.json").string(), result.summary.dump(2) + "\n");
-    report::write_file_atomically((dir / "views.svg").string(), views_svg(rows, loop));
-    report::write_file_atomically((dir / "history.svg").string(), history_svg(rows, loop));
+    // the four files as one set: a private folder, renamed into place when
+    // all are written (the previous set, if any, is left whole until then)
+    report::OutputSet set((fs::path(out_dir) / name).string());
+    const auto put_file = [&](const char* file, const std::string& text) {
+      if (should_stop && should_stop()) throw Interrupted();
+      set.write(file, text);
+    };
+    put_file("trace.csv", trace_csv(rows, loop));
+    put_file("summary.json", result.summary.dump(2) + "\n");
+    put_file("views.svg", views_svg(rows, loop));
+    put_file("history.svg", history_svg(rows, loop));
+    if (should_stop && should_stop()) throw Interrupted();
+    set.commit();
   }
   return result;
 }
@@ -389,14 +395,17 @@ void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
                const std::string& out_dir, int threads,
                const std::string& model_file,
-               const report::ProgressFn& progress) {
+               const report::ProgressFn& progress, const StopFn& stop) {
   std::atomic<std::size_t> finished{0};
   report::parallel_for(jobs->size(), threads > 0 ? threads : report::core_count(),
                [&](std::size_t i) {
                  CaseJob& job = (*jobs)[i];
                  try {
                    job.result = run_case(job.name, job.scene, overrides, out_dir,
-                                         model_file);
+                                         model_file, stop);
+                 } catch (const Interrupted& e) {
+                   job.error = e.what();
+                   job.interrupted = true;
                  } catch (const SimError& e) {
                    job.error = e.what();
                    job.bad_input = true;

@@ -1,8 +1,10 @@
 // Runs a case from start to end and writes its outputs: DIR/<case>/trace.csv
 // (one row per servo tick), DIR/<case>/summary.json (metrics and the
 // thesis's claims), and the plots views.svg and history.svg (plot_svg.h).
-// Each is written to a temporary name and renamed, so a failed run leaves
-// nothing half-written. docs/outputs.md documents the formats.
+// The four are written as one set (report::OutputSet): into a private
+// temporary folder beside DIR/<case>, renamed into place once all are
+// complete, so a failed or interrupted run leaves the previous set (or
+// none) and nothing half-written. docs/outputs.md documents the formats.
 #ifndef VMHAPTICS_STUDIES_RUN_CASE_H_
 #define VMHAPTICS_STUDIES_RUN_CASE_H_
 
@@ -10,6 +12,8 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -47,16 +51,26 @@ struct CaseResult {
   int partial_claims = 0;  // claims that hold on some sides only
 };
 
+// Polled between ticks and before the outputs are written: true asks the
+// run to stop (a signal, cli/run.cc); the run then throws Interrupted.
+using StopFn = std::function<bool()>;
+struct Interrupted : std::runtime_error {
+  Interrupted() : std::runtime_error("interrupted") {}
+};
+
 // Runs `scene` (with `overrides`) for its duration and, if out_dir is not
 // empty, writes out_dir/<name>/{trace.csv, summary.json, views.svg,
 // history.svg}. `model_file` (not empty): a calibrated Omni MJCF whose
 // parameters replace the scene's Omni's (sim::omni_model_hook; recorded in
 // summary.json's "model"). Throws SimError on bad input (before anything is
-// written).
+// written), Interrupted when `stop` (if set) says so (nothing written, any
+// previous set left as it was), std::runtime_error naming the file and the
+// OS error when a file cannot be written (likewise).
 CaseResult run_case(const std::string& name, const std::string& scene,
                     const std::vector<std::string>& overrides,
                     const std::string& out_dir,
-                    const std::string& model_file = "");
+                    const std::string& model_file = "",
+                    const StopFn& stop = {});
 
 // One run of run_cases(): the case's name and scene, and what came of it.
 struct CaseJob {
@@ -65,6 +79,7 @@ struct CaseJob {
   CaseResult result;   // filled when error is empty
   std::string error;   // the exception's message, if the run threw
   bool bad_input = false;  // the error was a SimError (bad scene or field)
+  bool interrupted = false;  // stopped by `stop` (error says "interrupted")
 };
 
 // Runs every job through run_case() on `threads` threads (0: one per core,
@@ -72,11 +87,13 @@ struct CaseJob {
 // model and data. Exceptions are caught per job and recorded in it.
 // `model_file`: run_case's, for every job. `progress` (if set) is called
 // from the worker threads with (jobs finished, jobs) as each one ends.
+// `stop`: run_case's, for every job (polled from the worker threads).
 void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
                const std::string& out_dir, int threads,
                const std::string& model_file = "",
-               const report::ProgressFn& progress = {});
+               const report::ProgressFn& progress = {},
+               const StopFn& stop = {});
 
 // summary.json's pieces, for other writers of the same format (hw run)
 nlohmann::json claim_json(const Claim& c);

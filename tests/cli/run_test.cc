@@ -4,10 +4,19 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <map>
+#include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "tests/support/cli_run.h"
@@ -275,6 +284,215 @@ TEST(RunCli, NonFinitePhysicsStopsTheRunWithExitOne) {
   const std::size_t last = r.err.rfind('\n', r.err.size() - 2);
   EXPECT_EQ(r.err.compare(last + 1, 17, "vmhaptics: error:"), 0) << r.err;
   EXPECT_TRUE(fs::is_empty(dir)) << "left a file in the working directory";
+}
+
+// ---- whole output sets (docs/outputs.md, "run": how a set is written) ----
+
+// the lines of a text file
+int count_lines(const fs::path& p) {
+  std::ifstream in(p);
+  int lines = 0;
+  std::string line;
+  while (std::getline(in, line)) ++lines;
+  return lines;
+}
+
+// `out` holds only complete sets: no hidden or temporary entry, and each
+// case folder has the four files, a summary that parses and a trace of
+// metrics.ticks rows after its header. Returns the summaries by case.
+std::map<std::string, nlohmann::json> complete_sets(const fs::path& out) {
+  std::map<std::string, nlohmann::json> sets;
+  for (const auto& e : fs::directory_iterator(out)) {
+    const std::string name = e.path().filename().string();
+    EXPECT_NE(name[0], '.') << "left behind: " << name;
+    EXPECT_EQ(name.find(".tmp"), std::string::npos) << "left behind: " << name;
+    if (name[0] == '.') continue;
+    EXPECT_TRUE(e.is_directory()) << name;
+    std::set<std::string> files;
+    for (const auto& f : fs::directory_iterator(e.path())) {
+      files.insert(f.path().filename().string());
+    }
+    EXPECT_EQ(files, std::set<std::string>({"history.svg", "summary.json",
+                                            "trace.csv", "views.svg"}))
+        << name;
+    std::ifstream js(e.path() / "summary.json");
+    nlohmann::json s;
+    try {
+      s = nlohmann::json::parse(js);
+    } catch (const std::exception& ex) {
+      ADD_FAILURE() << name << "/summary.json: " << ex.what();
+      continue;
+    }
+    EXPECT_EQ(count_lines(e.path() / "trace.csv"),
+              s.at("metrics").at("ticks").get<int>() + 1)
+        << name;
+    sets[name] = s;
+  }
+  return sets;
+}
+
+// a run over an existing set replaces it whole: the new trace and summary,
+// nothing of the old and no temporary left beside it
+TEST(RunCli, ASecondRunReplacesTheSetWhole) {
+  const fs::path out = fresh_dir("replace");
+  ASSERT_EQ(run("run case1 --duration 0.3 --set thesis_case=0 --out " + out.string())
+                .exit_code,
+            0);
+  EXPECT_EQ(complete_sets(out).at("case1").at("metrics").at("ticks"), 300);
+  std::ofstream(out / "case1" / "stale.txt") << "from before";
+  const auto r = run("run case1 --duration 0.5 --set thesis_case=0 --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto sets = complete_sets(out);  // stale.txt would fail it
+  ASSERT_EQ(sets.size(), 1u);
+  EXPECT_EQ(sets.at("case1").at("metrics").at("ticks"), 500);
+}
+
+// a file that cannot be written (here past a file-size limit, EFBIG; a full
+// disk, ENOSPC, takes the same path): exit 1 naming the file and the OS's
+// reason; the previous set is left as it was, and no temporary
+TEST(RunCli, AFailedWriteLeavesThePreviousSet) {
+  const fs::path out = fresh_dir("write_fails");
+  ASSERT_EQ(run("run case1 --duration 0.05 --set thesis_case=0 --out " + out.string())
+                .exit_code,
+            0);
+  // 100 blocks of 512 bytes: the summary fits, a 1 s trace (~0.9 MB) not
+  const auto r = run("run case1 --duration 1 --set thesis_case=0 --out " + out.string(),
+                     "trap '' XFSZ; ulimit -f 100; ");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("vmhaptics: error: run case1: " + (out / "case1" / "trace.csv").string() +
+                       ": File too large"),
+            std::string::npos)
+      << r.err;
+  const auto sets = complete_sets(out);
+  ASSERT_EQ(sets.size(), 1u);
+  EXPECT_EQ(sets.at("case1").at("metrics").at("ticks"), 50);
+}
+
+// `vmhaptics run <args>` in a child process, its stderr into `err`
+pid_t spawn(const std::vector<std::string>& args, const fs::path& err) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) dup2(fd, 2);
+    const int null = open("/dev/null", O_WRONLY);
+    if (null >= 0) dup2(null, 1);
+    std::vector<char*> argv = {const_cast<char*>(VMH_CLI_PATH)};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(VMH_CLI_PATH, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// SIGTERM or SIGINT during `run --all`: exit 143 / 130 soon after, one line
+// "interrupted: ...", and the out folder holds complete sets only (most
+// likely none: a case of 20 simulated seconds takes longer than 0.3 s)
+TEST(RunCli, ASignalLeavesOnlyCompleteSets) {
+  for (const int signo : {SIGTERM, SIGINT}) {
+    const std::string tag = signo == SIGTERM ? "sigterm" : "sigint";
+    const fs::path out = fresh_dir(tag);
+    const fs::path err = fresh_dir(tag + "_stderr.txt");
+    const pid_t pid = spawn({"run", "--all", "--out", out.string()}, err);
+    ASSERT_GT(pid, 0);
+    usleep(300000);
+    const auto sent = std::chrono::steady_clock::now();
+    ASSERT_EQ(kill(pid, signo), 0);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    const double took =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+    ASSERT_TRUE(WIFEXITED(status)) << tag;
+    EXPECT_EQ(WEXITSTATUS(status), 128 + signo) << tag;
+    EXPECT_LT(took, 5.0) << tag;
+    const std::string text = first_line(err);
+    EXPECT_EQ(text.rfind("vmhaptics: interrupted: run stopped by " +
+                             std::string(signo == SIGTERM ? "SIGTERM" : "SIGINT"),
+                         0),
+              0u)
+        << text;
+    // the sets finished before the signal, if any, are whole; nothing else
+    if (fs::exists(out)) complete_sets(out);
+  }
+}
+
+// a signal once some sets are complete: those are kept whole, the rest
+// removed
+TEST(RunCli, ASignalKeepsTheSetsAlreadyComplete) {
+  const fs::path out = fresh_dir("sigterm_late");
+  const fs::path err = fresh_dir("sigterm_late_stderr.txt");
+  // one case at a time, each of 5 simulated s (about a second of wall time
+  // with its mirrored and near-path runs): stopped as soon as case1's set
+  // is in place, while case2 runs
+  const pid_t pid = spawn({"run", "--all", "--jobs", "1", "--duration", "5",
+                           "--out", out.string()},
+                          err);
+  ASSERT_GT(pid, 0);
+  for (int i = 0; i < 3000 && !fs::exists(out / "case1"); ++i) usleep(10000);
+  ASSERT_EQ(kill(pid, SIGTERM), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 143) << first_line(err);
+  EXPECT_EQ(first_line(err),
+            "vmhaptics: interrupted: run stopped by SIGTERM; complete sets kept: case1");
+  const auto sets = complete_sets(out);
+  ASSERT_EQ(sets.size(), 1u);
+  EXPECT_EQ(sets.at("case1").at("metrics").at("ticks"), 5000);
+}
+
+// two runs into one --out at once: both finish, and what is left is whole
+// sets, each one run's own (the summary's ticks match the trace's rows)
+TEST(RunCli, ConcurrentRunsIntoOneOutLeaveWholeSets) {
+  const fs::path out = fresh_dir("concurrent");
+  vmh::testing::CliRun a;
+  vmh::testing::CliRun b;
+  std::thread ta([&] {
+    a = run("run case1 --duration 3 --set thesis_case=0 --out " + out.string());
+  });
+  std::thread tb([&] {
+    b = run("run case1 --duration 4 --set thesis_case=0 --out " + out.string());
+  });
+  ta.join();
+  tb.join();
+  EXPECT_EQ(a.exit_code, 0) << a.err;
+  EXPECT_EQ(b.exit_code, 0) << b.err;
+  const auto sets = complete_sets(out);
+  ASSERT_EQ(sets.size(), 1u);
+  const int ticks = sets.at("case1").at("metrics").at("ticks");
+  EXPECT_TRUE(ticks == 3000 || ticks == 4000) << ticks;
+}
+
+// an --out that cannot hold the sets: exit 2 before any simulation (--all
+// would take minutes), one line naming the path and the OS's reason
+void expect_refused_out(const fs::path& out, const std::string& reason) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto r = run("run --all --out " + out.string());
+  const double took =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.exit_code, 2) << out << ": " << r.err;
+  EXPECT_LT(took, 2.0) << out;
+  EXPECT_EQ(r.err, "vmhaptics: error: run: --out " + out.string() + ": " + reason + "\n");
+  EXPECT_EQ(r.out, "");
+}
+
+TEST(RunCli, AnOutThatIsAFileIsRefusedBeforeAnyRun) {
+  const fs::path dir = fresh_dir("out_file");
+  fs::create_directories(dir);
+  std::ofstream(dir / "file") << "x";
+  expect_refused_out(dir / "file", "Not a directory");
+  expect_refused_out(dir / "file" / "sub", "Not a directory");
+  EXPECT_EQ(first_line(dir / "file"), "x");
+}
+
+TEST(RunCli, AReadOnlyOutIsRefusedBeforeAnyRun) {
+  if (getuid() == 0) GTEST_SKIP() << "root writes in a read-only folder";
+  const fs::path dir = fresh_dir("out_read_only");
+  fs::create_directories(dir);
+  fs::permissions(dir, fs::perms::owner_read | fs::perms::owner_exec);
+  expect_refused_out(dir, "Permission denied");
+  expect_refused_out(dir / "sub", "Permission denied");
+  fs::permissions(dir, fs::perms::owner_all);
 }
 
 }  // namespace

@@ -1,0 +1,201 @@
+// report/output_file.h: single files through a unique temporary name, and
+// a folder's files as one set renamed into place whole (OutputSet).
+#include "report/output_file.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace vmh::report {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh(const std::string& name) {
+  const fs::path d = fs::path(::testing::TempDir()) / ("vmh_output_file_" + name);
+  fs::remove_all(d);
+  return d;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// the names in a folder
+std::set<std::string> names(const fs::path& d) {
+  std::set<std::string> n;
+  for (const auto& e : fs::directory_iterator(d)) n.insert(e.path().filename().string());
+  return n;
+}
+
+TEST(WriteFileAtomically, WritesAndLeavesNoTemporary) {
+  const fs::path d = fresh("single");
+  fs::create_directories(d);
+  write_file_atomically((d / "a.txt").string(), "one");
+  write_file_atomically((d / "a.txt").string(), "two");
+  EXPECT_EQ(slurp(d / "a.txt"), "two");
+  EXPECT_EQ(names(d), std::set<std::string>({"a.txt"}));
+}
+
+TEST(WriteFileAtomically, NamesThePathAndTheOsReason) {
+  const fs::path d = fresh("single_missing");
+  try {
+    write_file_atomically((d / "no" / "a.txt").string(), "x");
+    FAIL() << "written";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              (d / "no" / "a.txt").string() + ": No such file or directory");
+  }
+}
+
+TEST(OutputSet, FirstSetIsRenamedIntoPlace) {
+  const fs::path d = fresh("first");
+  {
+    OutputSet set((d / "case1").string());
+    EXPECT_EQ(fs::path(set.temp_dir()).parent_path(), d);
+    EXPECT_EQ(fs::path(set.temp_dir()).filename().string().rfind(
+                  ".case1.tmp-" + std::to_string(getpid()) + "-", 0),
+              0u);
+    set.write("a.txt", "A");
+    set.write("b.txt", "B");
+    // nothing at the destination until the set is complete
+    EXPECT_FALSE(fs::exists(d / "case1"));
+    set.commit();
+  }
+  EXPECT_EQ(names(d), std::set<std::string>({"case1"}));
+  EXPECT_EQ(names(d / "case1"), std::set<std::string>({"a.txt", "b.txt"}));
+  EXPECT_EQ(slurp(d / "case1" / "a.txt"), "A");
+}
+
+TEST(OutputSet, ASecondSetReplacesTheFirstWhole) {
+  const fs::path d = fresh("second");
+  {
+    OutputSet set((d / "case1").string());
+    set.write("a.txt", "old A");
+    set.write("old_only.txt", "old");
+    set.commit();
+  }
+  {
+    OutputSet set((d / "case1").string());
+    set.write("a.txt", "new A");
+    // the previous set stays whole until the commit
+    EXPECT_EQ(slurp(d / "case1" / "a.txt"), "old A");
+    set.commit();
+  }
+  EXPECT_EQ(names(d), std::set<std::string>({"case1"}));
+  EXPECT_EQ(names(d / "case1"), std::set<std::string>({"a.txt"}));
+  EXPECT_EQ(slurp(d / "case1" / "a.txt"), "new A");
+}
+
+// an error part way (here a file that cannot be made; ENOSPC takes the same
+// path): the exception names the file and the OS error, the temporary
+// folder goes, the previous set stays as it was
+TEST(OutputSet, AFailedSetLeavesThePreviousOneAndNoTemporary) {
+  const fs::path d = fresh("failed");
+  {
+    OutputSet set((d / "case1").string());
+    set.write("a.txt", "old A");
+    set.commit();
+  }
+  try {
+    OutputSet set((d / "case1").string());
+    set.write("a.txt", "new A");
+    set.write("no/b.txt", "B");
+    set.commit();
+    FAIL() << "committed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              (d / "case1" / "no" / "b.txt").string() + ": No such file or directory");
+  }
+  EXPECT_EQ(names(d), std::set<std::string>({"case1"}));
+  EXPECT_EQ(slurp(d / "case1" / "a.txt"), "old A");
+}
+
+TEST(OutputSet, WithoutCommitNothingIsLeft) {
+  const fs::path d = fresh("uncommitted");
+  {
+    OutputSet set((d / "case1").string());
+    set.write("a.txt", "A");
+  }
+  EXPECT_TRUE(names(d).empty());
+}
+
+// many writers of one destination at once: each commit succeeds, the last
+// set is whole (its two files agree), nothing else is left
+TEST(OutputSet, ConcurrentWritersLeaveOneWholeSet) {
+  const fs::path d = fresh("concurrent");
+  std::vector<std::thread> threads;
+  std::vector<std::string> errors(8);
+  for (int t = 0; t < 8; ++t) {
+    threads.emplace_back([&, t] {
+      try {
+        for (int i = 0; i < 20; ++i) {
+          OutputSet set((d / "case1").string());
+          const std::string tag = std::to_string(t) + "." + std::to_string(i);
+          set.write("a.txt", tag);
+          set.write("b.txt", tag);
+          set.commit();
+        }
+      } catch (const std::exception& e) {
+        errors[static_cast<std::size_t>(t)] = e.what();
+      }
+    });
+  }
+  for (std::thread& th : threads) th.join();
+  for (const std::string& e : errors) EXPECT_EQ(e, "");
+  EXPECT_EQ(names(d), std::set<std::string>({"case1"}));
+  EXPECT_EQ(names(d / "case1"), std::set<std::string>({"a.txt", "b.txt"}));
+  EXPECT_EQ(slurp(d / "case1" / "a.txt"), slurp(d / "case1" / "b.txt"));
+}
+
+// the check leaves things as they were: no probe, and no folder it made
+TEST(CheckWritableDir, LeavesNoProbeAndNoFolderItMade) {
+  const fs::path d = fresh("writable");
+  fs::create_directories(d);
+  check_writable_dir(d.string());
+  EXPECT_TRUE(names(d).empty());
+  check_writable_dir((d / "a" / "b").string());
+  EXPECT_TRUE(names(d).empty());
+}
+
+TEST(CheckWritableDir, NamesAFileOrAPathUnderAFile) {
+  const fs::path d = fresh("not_dir");
+  fs::create_directories(d);
+  std::ofstream(d / "file") << "x";
+  for (const fs::path& p : {d / "file", d / "file" / "sub"}) {
+    try {
+      check_writable_dir(p.string());
+      FAIL() << p;
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), p.string() + ": Not a directory");
+    }
+  }
+}
+
+TEST(CheckWritableDir, NamesAReadOnlyFolder) {
+  if (getuid() == 0) GTEST_SKIP() << "root writes in a read-only folder";
+  const fs::path d = fresh("read_only");
+  fs::create_directories(d);
+  fs::permissions(d, fs::perms::owner_read | fs::perms::owner_exec);
+  try {
+    check_writable_dir(d.string());
+    ADD_FAILURE() << "writable";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), d.string() + ": Permission denied");
+  }
+  fs::permissions(d, fs::perms::owner_all);
+}
+
+}  // namespace
+}  // namespace vmh::report
