@@ -44,9 +44,10 @@ std::string join(const std::set<std::string>& names) {
 
 // the direction along the path from X_V toward X_R: their difference with
 // the path's normal(s) at X_V removed
-Vec3 along_path_toward_xr(const TraceRow& r, const ControllerParams& p) {
-  Vec3 w = r.out.x_r_mm - r.out.x_v_mm;
-  const Vec3 radial = (r.out.x_v_mm - p.vm.pivot_mm).normalized();
+Vec3 along_path_toward_xr(const Vec3& x_v_mm, const Vec3& x_r_mm,
+                          const ControllerParams& p) {
+  Vec3 w = x_r_mm - x_v_mm;
+  const Vec3 radial = (x_v_mm - p.vm.pivot_mm).normalized();
   w -= w.dot(radial) * radial;
   if (p.vm.kind == VmKind::kCircle) {
     const Vec3 n = p.vm.R_pivot.col(2);
@@ -120,7 +121,7 @@ RunMetrics run_metrics(const std::vector<TraceRow>& rows,
   return m;
 }
 
-void merge_sides(std::vector<Claim>* first, const SideRun& where_first,
+void merge_sides(std::vector<Claim>* first, const SideLabel& where_first,
                  const std::vector<SideRun>& others) {
   const auto side = [](const Claim& c, const std::string& where) {
     Claim::Side s;
@@ -135,8 +136,8 @@ void merge_sides(std::vector<Claim>* first, const SideRun& where_first,
   };
   for (Claim& c : *first) {
     const bool off_path = c.window.find("off_") != std::string::npos;
-    const auto label = [&](const SideRun& r) {
-      return off_path ? r.where_off_path : r.where;
+    const auto label = [&](const SideLabel& l) {
+      return off_path ? l.where_off_path : l.where;
     };
     c.sides = {side(c, label(where_first))};
     for (const SideRun& run : others) {
@@ -144,7 +145,9 @@ void merge_sides(std::vector<Claim>* first, const SideRun& where_first,
       const auto other =
           std::find_if(run.claims.begin(), run.claims.end(),
                        [&](const Claim& o) { return o.name == c.name; });
-      if (other != run.claims.end()) c.sides.push_back(side(*other, label(run)));
+      if (other != run.claims.end()) {
+        c.sides.push_back(side(*other, label(run.label)));
+      }
     }
     int held = 0;
     std::string where;
@@ -183,15 +186,13 @@ class Predictions {
   const LawPrediction& at(const TraceRow* r) const {
     return at_[static_cast<std::size_t>(r - rows_->data())];
   }
-  // the ground-truth pose of a row, device frame
+  // at the ground-truth pose of a row, device frame: the row's true wrist
+  // centre (omni_fk of q_true_dh) and the stylus axis of the same angles
   static LawPrediction predict(const TraceRow& r, const ControllerParams& p) {
     const OmniPose pose = omni_fk(p.omni, r.q_true_dh);
-    return predict_static_law(p, base_to_device_mm(p.omni, pose.p_base_m),
+    return predict_static_law(p, r.p_true_mm,
                               base_to_device_vector(pose.R_base.col(2)),
                               r.q_true_dh);
-  }
-  static Vec3 p_true_mm(const TraceRow& r, const ControllerParams& p) {
-    return base_to_device_mm(p.omni, omni_fk(p.omni, r.q_true_dh).p_base_m);
   }
   const ControllerParams& params() const { return p_; }
 
@@ -276,7 +277,6 @@ constexpr const char* kStaticNote =
 void position_claims(const std::vector<TraceRow>& rows, const HandScript& script,
                      const Predictions& pred, std::vector<Claim>* claims_out) {
   std::vector<Claim>& claims = *claims_out;
-  const ControllerParams& p = pred.params();
   const std::set<std::string> off = {"off_out", "off_out_misaligned", "off_in"};
   const std::set<std::string> on = {"on_misaligned_a", "on_misaligned_b"};
   {
@@ -316,7 +316,7 @@ void position_claims(const std::vector<TraceRow>& rows, const HandScript& script
       const double ap =
           lp.available
               ? angle_deg(lp.force_limited_N,
-                          lp.x_v_mm - Predictions::p_true_mm(*r, p))
+                          lp.x_v_mm - r->p_true_mm)
               : std::nan("");
       if (std::isfinite(ap)) {
         worst_p = std::max(worst_p, ap);
@@ -340,7 +340,6 @@ void orientation_claims(const std::vector<TraceRow>& rows,
                         const HandScript& script, const Predictions& pred,
                         std::vector<Claim>* claims_out) {
   std::vector<Claim>& claims = *claims_out;
-  const ControllerParams& p = pred.params();
   const std::set<std::string> off_mis = {"off_out_misaligned"};
   const std::set<std::string> on = {"on_misaligned_a", "on_misaligned_b"};
   // between X_V and X_R (from p), nearer X_V
@@ -365,7 +364,7 @@ void orientation_claims(const std::vector<TraceRow>& rows,
       const LawPrediction& lp = pred.at(r);
       if (!lp.available) continue;
       const bool gp = between(lp.force_limited_N, lp.x_v_mm, lp.x_r_mm,
-                              Predictions::p_true_mm(*r, p), &ok);
+                              r->p_true_mm, &ok);
       if (ok) {
         ++np;
         good_p += gp ? 1 : 0;
@@ -393,7 +392,7 @@ void orientation_claims(const std::vector<TraceRow>& rows,
       const LawPrediction& lp = pred.at(r);
       if (!lp.available) continue;
       fp.push_back(lp.force_limited_N.norm());
-      if (lp.force_limited_N.dot(lp.x_r_mm - Predictions::p_true_mm(*r, p)) >
+      if (lp.force_limited_N.dot(lp.x_r_mm - r->p_true_mm) >
           0.0) {
         ++toward_p;
       }
@@ -420,18 +419,6 @@ void orientation_claims(const std::vector<TraceRow>& rows,
   }
 }
 
-// the direction along the path from X_V toward X_R at a predicted pose
-Vec3 along_path_predicted(const LawPrediction& lp, const ControllerParams& p) {
-  Vec3 w = lp.x_r_mm - lp.x_v_mm;
-  const Vec3 radial = (lp.x_v_mm - p.vm.pivot_mm).normalized();
-  w -= w.dot(radial) * radial;
-  if (p.vm.kind == VmKind::kCircle) {
-    const Vec3 n = p.vm.R_pivot.col(2);
-    w -= w.dot(n) * n;
-  }
-  return w;
-}
-
 // Case 2's "bending feel" on a circle: along the path, not across it.
 void along_path_claim(const std::vector<TraceRow>& rows, const HandScript& script,
                       const Predictions& pred, std::vector<Claim>* claims) {
@@ -441,12 +428,14 @@ void along_path_claim(const std::vector<TraceRow>& rows, const HandScript& scrip
   std::vector<double> a, ap;
   for (const TraceRow* r : w) {
     const double x =
-        angle_deg(r->out.force_device_N, along_path_toward_xr(*r, p));
+        angle_deg(r->out.force_device_N,
+                  along_path_toward_xr(r->out.x_v_mm, r->out.x_r_mm, p));
     if (std::isfinite(x)) a.push_back(x);
     const LawPrediction& lp = pred.at(r);
     if (!lp.available) continue;
     const double y =
-        angle_deg(lp.force_limited_N, along_path_predicted(lp, p));
+        angle_deg(lp.force_limited_N,
+                  along_path_toward_xr(lp.x_v_mm, lp.x_r_mm, p));
     if (std::isfinite(y)) ap.push_back(y);
   }
   Claim c = make(
@@ -481,7 +470,7 @@ void weighting_claim(int thesis_case, const std::vector<TraceRow>& rows,
     if (!lp.available || !ref) continue;
     const LawPrediction lr = Predictions::predict(*r, *ref);
     if (!lr.available) continue;
-    const Vec3 dv_p = lp.x_v_mm - Predictions::p_true_mm(*r, p);
+    const Vec3 dv_p = lp.x_v_mm - r->p_true_mm;
     const double ap = angle_deg(lp.force_limited_N, dv_p);
     const double bp = angle_deg(lr.force_limited_N, dv_p);
     if (std::isfinite(ap) && std::isfinite(bp)) {

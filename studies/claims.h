@@ -62,22 +62,26 @@ struct Claim {
   std::string holds_where;
 };
 
+// Where a run of a case was tried, as a side's label.
+struct SideLabel {
+  std::string where;           // the side, for every claim
+  std::string where_off_path;  // the same for the off-path claims
+};
+
 // The claims of one more run of the same case (the script mirrored, or
 // held nearer the path), as a side of each claim in `first`.
 struct SideRun {
-  std::string where;           // the side, for every claim
-  std::string where_off_path;  // the same for the off-path claims
+  SideLabel label;
   std::vector<Claim> claims;
   // the run only changes the off-path holds: it is a side of the claims
   // measured over them (windows off_out, off_out_misaligned, off_in) only
   bool off_path_only = false;
 };
 
-// Makes `first` (the claims of the run as given, labelled by where_first's
-// labels; its claims are not read) and
+// Makes `first` (the claims of the run as given, labelled where_first) and
 // the claims of `others` (matched by name) sides of each claim, and sets
 // pass, partial and holds_where from them.
-void merge_sides(std::vector<Claim>* first, const SideRun& where_first,
+void merge_sides(std::vector<Claim>* first, const SideLabel& where_first,
                  const std::vector<SideRun>& others);
 
 struct RunMetrics {

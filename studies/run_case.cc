@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 
 #include "controller/device_frame.h"
 #include "report/output_file.h"
@@ -237,12 +238,15 @@ std::vector<TraceRow> run_to_end(ClosedLoop* loop, const StopFn& stop) {
   return rows;
 }
 
-// the case field's numbers as the run has them
-std::vector<double> field_numbers(const ClosedLoop& loop, const char* name) {
-  for (const FieldSpec& f : case_fields()) {
-    if (std::strcmp(f.name, name) == 0) return loop.config().value(f).numbers;
+// "name=a,b,c": a --set override with every digit of the values
+std::string override_text(const char* field, std::initializer_list<double> v) {
+  std::string s = std::string(field) + "=";
+  char buf[32];
+  for (double x : v) {
+    std::snprintf(buf, sizeof buf, "%.17g", x);
+    s += (s.back() == '=' ? "" : ",") + std::string(buf);
   }
-  return {};
+  return s;
 }
 
 }  // namespace
@@ -270,11 +274,8 @@ CaseResult run_case(const std::string& name, const std::string& scene,
   // the same script mirrored left to right (script_dir's and script_axis's
   // x negated), and held near the path (script_near_off_mm): a claim that
   // holds on some of these only is partial
-  const std::vector<double> start_dir = field_numbers(loop, "script_dir");
-  const std::vector<double> off = field_numbers(loop, "script_off_mm");
-  const std::vector<double> near = field_numbers(loop, "script_near_off_mm");
-  if (!result.claims.empty() && start_dir.size() == 3 && off.size() == 1 &&
-      near.size() == 1) {
+  const ScriptSettings& script = loop.config().script;
+  if (!result.claims.empty()) {
     const auto run_with = [&](std::vector<std::string> extra) {
       std::vector<std::string> o = overrides;
       o.insert(o.end(), extra.begin(), extra.end());
@@ -282,42 +283,33 @@ CaseResult run_case(const std::string& name, const std::string& scene,
       const std::vector<TraceRow> r = run_to_end(&l, should_stop);
       return evaluate_claims(thesis_case, r, l);
     };
-    const auto number = [](const char* field, double v) {
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "%s=%.17g", field, v);
-      return std::string(buf);
-    };
     const auto side = [](double x, double off_mm, const char* more) {
-      SideRun r;
-      r.where = x < 0.0 ? "left of the pivot" : "right of the pivot";
+      SideLabel l;
+      l.where = x < 0.0 ? "left of the pivot" : "right of the pivot";
       char buf[96];
       std::snprintf(buf, sizeof buf, ", off-path holds %g mm out%s", off_mm, more);
-      r.where_off_path = r.where + buf;
-      return r;
+      l.where_off_path = l.where + buf;
+      return l;
     };
+    const Vec3& dir = script.dir;
+    const Vec3& axis = script.axis;
     std::vector<SideRun> others;
-    if (std::abs(start_dir[0]) > 1e-9) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "script_dir=%.17g,%.17g,%.17g",
-                    -start_dir[0], start_dir[1], start_dir[2]);
-      std::vector<std::string> mirrored = {buf};
-      const std::vector<double> axis = field_numbers(loop, "script_axis");
-      if (axis.size() == 3 && (axis[0] != 0.0 || axis[1] != 0.0 || axis[2] != 0.0)) {
-        std::snprintf(buf, sizeof buf, "script_axis=%.17g,%.17g,%.17g",
-                      -axis[0], axis[1], axis[2]);
-        mirrored.emplace_back(buf);
+    if (std::abs(dir.x()) > 1e-9) {
+      std::vector<std::string> mirrored = {
+          override_text("script_dir", {-dir.x(), dir.y(), dir.z()})};
+      if (!axis.isZero(0.0)) {
+        mirrored.push_back(
+            override_text("script_axis", {-axis.x(), axis.y(), axis.z()}));
       }
-      SideRun r = side(-start_dir[0], off[0], "");
-      r.claims = run_with(mirrored);
-      others.push_back(r);
+      others.push_back({side(-dir.x(), script.off_mm, ""), run_with(mirrored)});
     }
-    if (near[0] > 0.0 && near[0] != off[0]) {
-      SideRun r = side(start_dir[0], near[0], " (near the path)");
-      r.claims = run_with({number("script_off_mm", near[0])});
-      r.off_path_only = true;
-      others.push_back(r);
+    if (script.near_off_mm > 0.0 && script.near_off_mm != script.off_mm) {
+      others.push_back(
+          {side(dir.x(), script.near_off_mm, " (near the path)"),
+           run_with({override_text("script_off_mm", {script.near_off_mm})}),
+           /*off_path_only=*/true});
     }
-    merge_sides(&result.claims, side(start_dir[0], off[0], ""), others);
+    merge_sides(&result.claims, side(dir.x(), script.off_mm, ""), others);
   }
   // a claim that holds on one side only is reported, not failed
   for (const Claim& c : result.claims) {
