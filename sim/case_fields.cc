@@ -325,6 +325,17 @@ const std::vector<ParamSpec>& case_fields() {
                 p->script.near_off_mm = item(v);
               })
           .non_negative(),
+      numeric("script", "script_below_dir", 3, "-0.35 -0.2 0.65", "-",
+              "run_case runs the case once more from below the pivot, with "
+              "this device-frame direction in place of script_dir (on both "
+              "sides: its x as given and negated; script_axis's y negated "
+              "when set). script_dir's own y negated would point the stylus "
+              "down and forward, where the sphere cases hold the gimbal's q5 "
+              "on its -1.13 rad stop and the hand's wrist torque drives the "
+              "RM off the path through it; 0 0 0: no runs below",
+              [](CaseParams* p, const ParamValue& v) {
+                p->script.below_dir = vec3(v);
+              }),
       numeric("script", "script_misalign_rad", 1, "0.5", "rad",
               "stylus misalignment on the path",
               [](CaseParams* p, const ParamValue& v) {

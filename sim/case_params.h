@@ -112,6 +112,9 @@ struct ScriptSettings {
   // run_case's run near the path, for the off-path claims in the linear
   // regime: the hand target this far off (mm); 0: no such run
   double near_off_mm{};
+  // run_case's start direction below the pivot (device frame, run on both
+  // sides: x as given and negated); zero: no runs below
+  Vec3 below_dir = Vec3::Zero();
   double misalign_rad{};
   double sweep_mm{};
   double sweep_rad{};

@@ -271,9 +271,11 @@ CaseResult run_case(const std::string& name, const std::string& scene,
 
   result.metrics = run_metrics(rows, loop);
   result.claims = evaluate_claims(thesis_case, rows, loop);
-  // the same script mirrored left to right (script_dir's and script_axis's
-  // x negated), and held near the path (script_near_off_mm): a claim that
-  // holds on some of these only is partial
+  // the same script on the other sides of the pivot: mirrored left to right
+  // (script_dir's and script_axis's x negated), from below the pivot
+  // (script_below_dir, on both sides), and once more with the off-path holds
+  // near the path (script_near_off_mm): a claim that holds on some of these
+  // only is partial
   const ScriptSettings& script = loop.config().script;
   if (!result.claims.empty()) {
     const auto run_with = [&](std::vector<std::string> extra) {
@@ -283,33 +285,47 @@ CaseResult run_case(const std::string& name, const std::string& scene,
       const std::vector<TraceRow> r = run_to_end(&l, should_stop);
       return evaluate_claims(thesis_case, r, l);
     };
-    const auto side = [](double x, double off_mm, const char* more) {
+    // a side's label from where its start pose is (device frame: x right,
+    // y up) and how far off the path its off-path holds are
+    const auto side = [](const Vec3& d, double off_mm, const char* more) {
       SideLabel l;
-      l.where = x < 0.0 ? "left of the pivot" : "right of the pivot";
+      l.where = d.x() < 0.0 ? "left of the pivot" : "right of the pivot";
+      if (std::abs(d.y()) > 1e-9) l.where += d.y() > 0.0 ? ", above it" : ", below it";
       char buf[96];
-      std::snprintf(buf, sizeof buf, ", off-path holds %g mm out%s", off_mm, more);
+      std::snprintf(buf, sizeof buf, ", off-path holds %g mm out%s", off_mm,
+                    more);
       l.where_off_path = l.where + buf;
       return l;
     };
-    const Vec3& dir = script.dir;
     const Vec3& axis = script.axis;
-    std::vector<SideRun> others;
-    if (std::abs(dir.x()) > 1e-9) {
-      std::vector<std::string> mirrored = {
-          override_text("script_dir", {-dir.x(), dir.y(), dir.z()})};
-      if (!axis.isZero(0.0)) {
-        mirrored.push_back(
-            override_text("script_axis", {-axis.x(), axis.y(), axis.z()}));
+    // the start direction d (stylus axis `a` if set) and its mirror image
+    const auto both_sides = [&](const Vec3& d, const Vec3& a, bool given,
+                                std::vector<SideRun>* out) {
+      for (const double sx : {1.0, -1.0}) {
+        if (given && sx > 0.0) continue;  // the run already made
+        if (sx < 0.0 && std::abs(d.x()) <= 1e-9) continue;  // no mirror image
+        const Vec3 ds(sx * d.x(), d.y(), d.z());
+        std::vector<std::string> o = {
+            override_text("script_dir", {ds.x(), ds.y(), ds.z()})};
+        if (!a.isZero(0.0)) {
+          o.push_back(override_text("script_axis", {sx * a.x(), a.y(), a.z()}));
+        }
+        out->push_back({side(ds, script.off_mm, ""), run_with(o)});
       }
-      others.push_back({side(-dir.x(), script.off_mm, ""), run_with(mirrored)});
+    };
+    std::vector<SideRun> others;
+    both_sides(script.dir, axis, /*given=*/true, &others);
+    if (!script.below_dir.isZero(0.0)) {
+      both_sides(script.below_dir, Vec3(axis.x(), -axis.y(), axis.z()),
+                 /*given=*/false, &others);
     }
     if (script.near_off_mm > 0.0 && script.near_off_mm != script.off_mm) {
       others.push_back(
-          {side(dir.x(), script.near_off_mm, " (near the path)"),
+          {side(script.dir, script.near_off_mm, " (near the path)"),
            run_with({override_text("script_off_mm", {script.near_off_mm})}),
            /*off_path_only=*/true});
     }
-    merge_sides(&result.claims, side(dir.x(), script.off_mm, ""), others);
+    merge_sides(&result.claims, side(script.dir, script.off_mm, ""), others);
   }
   // a claim that holds on one side only is reported, not failed
   for (const Claim& c : result.claims) {

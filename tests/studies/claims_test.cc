@@ -22,7 +22,8 @@ using CaseTest = testing::ThesisCaseTest;
 
 // The claims expected to hold on some sides only: case 6's "toward
 // X(theta_R)" under the thesis's error (eq. 3.35-3.37 as printed;
-// docs/errata.md, erratum 26) holds left of the pivot only, and "between
+// docs/errata.md, erratum 26) holds left of the pivot only (above and below
+// it), and "between
 // X(theta_V) and X(theta_R), nearer X(theta_V)" only far off the path, in
 // the saturated regime (near it the orientation term dominates).
 bool expected_partial(int thesis_case, const std::string& claim) {
@@ -35,8 +36,17 @@ bool off_path_claim(const Claim& c) {
 }
 
 void check_sides(int thesis_case, const Claim& c) {
-  // left and right of the pivot, and near the path for an off-path claim
-  ASSERT_EQ(c.sides.size(), off_path_claim(c) ? 3u : 2u) << c.name;
+  // left and right of the pivot, above and below it, and near the path for
+  // an off-path claim
+  ASSERT_EQ(c.sides.size(), off_path_claim(c) ? 5u : 4u) << c.name;
+  const char* where[] = {"left of the pivot, above it",
+                         "right of the pivot, above it",
+                         "left of the pivot, below it",
+                         "right of the pivot, below it"};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(c.sides[static_cast<std::size_t>(i)].where.rfind(where[i], 0), 0u)
+        << c.name << ": " << c.sides[static_cast<std::size_t>(i)].where;
+  }
   for (const Claim::Side& s : c.sides) {
     std::printf("  %-36s %s: %.4g (law %.4g, %s, %.1f mm off)%s\n", "",
                 s.where.c_str(), s.value, s.prediction.value_or(std::nan("")),
@@ -49,10 +59,13 @@ void check_sides(int thesis_case, const Claim& c) {
   }
   if (off_path_claim(c)) {
     // the held-near side is in the linear regime, the others saturated
-    EXPECT_NE(c.sides[2].where.find("near the path"), std::string::npos);
-    EXPECT_EQ(c.sides[2].regime, "linear") << c.name;
-    EXPECT_LT(c.sides[2].mean_path_distance_mm, 6.0) << c.name;
-    EXPECT_EQ(c.sides[0].regime, "saturated") << c.name;
+    EXPECT_NE(c.sides[4].where.find("near the path"), std::string::npos);
+    EXPECT_EQ(c.sides[4].regime, "linear") << c.name;
+    EXPECT_LT(c.sides[4].mean_path_distance_mm, 6.0) << c.name;
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(c.sides[static_cast<std::size_t>(i)].regime, "saturated")
+          << c.name << " " << c.sides[static_cast<std::size_t>(i)].where;
+    }
   }
   if (expected_partial(thesis_case, c.name)) {
     EXPECT_FALSE(c.pass) << c.name;
@@ -60,10 +73,15 @@ void check_sides(int thesis_case, const Claim& c) {
     if (off_path_claim(c)) {
       EXPECT_EQ(c.holds_where.find("near the path"), std::string::npos)
           << c.holds_where;
-      EXPECT_NE(c.holds_where.find("right of the pivot"), std::string::npos)
+      EXPECT_NE(c.holds_where.find("right of the pivot, above it"),
+                std::string::npos)
+          << c.holds_where;
+      EXPECT_NE(c.holds_where.find("right of the pivot, below it"),
+                std::string::npos)
           << c.holds_where;
     } else {
-      EXPECT_EQ(c.holds_where, "left of the pivot");
+      EXPECT_EQ(c.holds_where,
+                "left of the pivot, above it; left of the pivot, below it");
     }
   } else {
     EXPECT_TRUE(c.pass) << c.name << ": " << c.value << " " << c.comparison
@@ -103,8 +121,8 @@ TEST_P(CaseTest, ThesisClaimsHold) {
   }
 }
 
-// With the geometric orientation error case 6 holds every claim on both
-// sides of the pivot: its partial "toward X(theta_R)" above is the
+// With the geometric orientation error case 6 holds every claim on all four
+// sides of the pivot (left, right, above, below): its partial "toward X(theta_R)" above is the
 // thesis's formulation, not the law. (Near the path "nearer X(theta_V)"
 // still fails, as for every orientation case.)
 TEST(CaseSix, GeometricErrorHoldsOnBothSides) {
@@ -112,14 +130,17 @@ TEST(CaseSix, GeometricErrorHoldsOnBothSides) {
       run_case("case6", scene(6), {"error=geometric"}, "");
   ASSERT_FALSE(r.claims.empty());
   for (const Claim& c : r.claims) {
-    ASSERT_GE(c.sides.size(), 2u);
+    ASSERT_GE(c.sides.size(), 4u);
     for (const Claim::Side& s : c.sides) {
       const bool near = s.where.find("near the path") != std::string::npos;
       EXPECT_EQ(s.pass, !(near && c.name == "off_path_between_nearer_xv"))
           << c.name << " " << s.where;
       EXPECT_TRUE(s.matches_prediction.value_or(false)) << c.name << " " << s.where;
     }
-    EXPECT_TRUE(c.sides[0].pass && c.sides[1].pass) << c.name;
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_TRUE(c.sides[static_cast<std::size_t>(i)].pass)
+          << c.name << " " << c.sides[static_cast<std::size_t>(i)].where;
+    }
   }
 }
 
