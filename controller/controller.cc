@@ -8,6 +8,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "controller/trig.h"
 
 namespace vmh {
 namespace {
@@ -272,10 +273,19 @@ ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
   }
   // eq. 3.8 with eq. 3.28's diagonal gains, then eq. 3.11
   const Vec6 g = kp_.cwiseProduct(out->e) + kv_.cwiseProduct(out->e_dot);
-  active_columns(J_, locked, &J_active_);
-  const ProjectionResult pr = project_motion_force(
-      J_active_, params_.projection_weights, g, params_.singular_rcond,
-      params_.singular_damping, &out->f_motion);
+  ProjectionResult pr;
+  if (params_.vm.kind == VmKind::kSphere && locked == 0u) {
+    // the sphere's J^T W_A J in closed form from its polar angle
+    const SinCos polar = sin_cos(theta_v_[1]);
+    pr = project_motion_force_sphere(
+        J_, vm_->length(), polar.s, polar.c, params_.projection_weights, g,
+        params_.singular_rcond, params_.singular_damping, &out->f_motion);
+  } else {
+    active_columns(J_, locked, &J_active_);
+    pr = project_motion_force(J_active_, params_.projection_weights, g,
+                              params_.singular_rcond,
+                              params_.singular_damping, &out->f_motion);
+  }
   out->vm_rcond = pr.rcond;
   if (pr.singular) st |= kStatusVmSingular;
   return st;
