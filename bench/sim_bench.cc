@@ -63,13 +63,48 @@ void step_model(benchmark::State& state, bool with_hand) {
   DataPtr copy(mj_makeData(m));
   mj_copyData(copy.get(), m, loop.data());
   mjData* d = with_hand ? loop.data() : copy.get();
-  for (auto _ : state) mj_step(m, d);
+  long solver_iterations = 0;
+  for (auto _ : state) {
+    mj_step(m, d);
+    solver_iterations += d->solver_iter;
+  }
   state.SetItemsProcessed(state.iterations());
+  // the constraint solver's iterations in the step's last evaluation
+  state.counters["solver_iter"] =
+      static_cast<double>(solver_iterations) /
+      static_cast<double>(state.iterations());
   state.counters["time_s"] = d->time;
 }
 
 void BM_BareStep(benchmark::State& state) { step_model(state, false); }
 void BM_HandStep(benchmark::State& state) { step_model(state, true); }
+
+// The loop's own data stepped with the hand's callback replaced by one that
+// does nothing, so that qfrc_applied keeps the hand's last wrench: the state
+// BM_HandStep steps, without the hand's cost. Tells the hand's cost per
+// step (BM_HandStep - BM_HeldHandStep) from what stepping a held arm instead
+// of BM_BareStep's falling copy costs MuJoCo (BM_HeldHandStep - BM_BareStep).
+void noop_control(const mjModel*, mjData*) {}
+void BM_HeldHandStep(benchmark::State& state) {
+  ClosedLoop loop(case_scene(static_cast<int>(state.range(0))),
+                  setting(state.range(1)));
+  warm_loop(&loop);
+  const mjModel* m = loop.model();
+  mjData* d = loop.data();
+  mjfGeneric saved = mjcb_control;
+  mjcb_control = noop_control;
+  long solver_iterations = 0;
+  for (auto _ : state) {
+    mj_step(m, d);
+    solver_iterations += d->solver_iter;
+  }
+  mjcb_control = saved;
+  state.SetItemsProcessed(state.iterations());
+  state.counters["solver_iter"] =
+      static_cast<double>(solver_iterations) /
+      static_cast<double>(state.iterations());
+  state.counters["time_s"] = d->time;
+}
 
 void BM_ClosedLoopTick(benchmark::State& state) {
   ClosedLoop loop(case_scene(static_cast<int>(state.range(0))),
@@ -119,6 +154,7 @@ void cases_and_settings(benchmark::internal::Benchmark* b) {
 }
 BENCHMARK(BM_BareStep)->Apply(cases_and_settings);
 BENCHMARK(BM_HandStep)->Apply(cases_and_settings);
+BENCHMARK(BM_HeldHandStep)->Args({1, 0});
 BENCHMARK(BM_ClosedLoopTick)->Apply(cases_and_settings);
 BENCHMARK(BM_RunAll)->Iterations(1)->UseRealTime()->Unit(benchmark::kSecond);
 

@@ -275,6 +275,46 @@ ProjectionResult project_motion_force(const VmJacobian& J, const Vec6& W_A,
   return result;
 }
 
+ProjectionResult project_motion_force_sphere(const VmJacobian& J,
+                                             double length, double sin_polar,
+                                             double cos_polar, const Vec6& W_A,
+                                             const Vec6& g,
+                                             double singular_rcond,
+                                             double damping, Vec6* f) {
+  const double a = W_A[0], b = W_A[3];
+  const bool block_uniform = J.cols() == 3 && W_A[1] == a && W_A[2] == a &&
+                             W_A[4] == b && W_A[5] == b;
+  if (block_uniform) {
+    // J^T W_A J = [p 0 q; 0 m 0; q 0 r] (see the header)
+    const double aLL = a * length * length;
+    const double p = aLL * sin_polar * sin_polar + b;
+    const double m = aLL + b;
+    const double q = -b * cos_polar;
+    const double r = b;
+    // the 2 x 2 block's eigenvalues: the larger from the trace and the
+    // discriminant, the smaller as det / larger (no cancellation)
+    const double half_diff = 0.5 * (p - r);
+    const double big = 0.5 * (p + r) + std::sqrt(half_diff * half_diff + q * q);
+    const double det = p * r - q * q;
+    const double small = det / big;
+    const double s_max = std::max(big, m);
+    const double s_min = std::max(std::min(small, m), 0.0);
+    if (s_max > 0.0 && det > 0.0 && damping * s_max <= 1e-8 * s_min) {
+      ProjectionResult result;
+      result.rcond = s_min / s_max;
+      result.singular = !(result.rcond >= singular_rcond);
+      const Eigen::Matrix<double, 6, 3> J3 = J;
+      const Vec3 x = J3.transpose() * g;
+      const double inv_det = 1.0 / det;
+      const Vec3 z((r * x[0] - q * x[2]) * inv_det, x[1] / m,
+                   (p * x[2] - q * x[0]) * inv_det);
+      *f = g - W_A.asDiagonal() * (J3 * z);
+      return result;
+    }
+  }
+  return project_motion_force(J, W_A, g, singular_rcond, damping, f);
+}
+
 }  // namespace vmh
 
 #if defined(__GNUC__) && !defined(__clang__)

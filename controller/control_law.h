@@ -77,6 +77,25 @@ ProjectionResult project_motion_force(const VmJacobian& J, const Vec6& W_A,
                                       double damping, Vec6* f,
                                       Mat6* projector = nullptr);
 
+// The same projection for the sphere (SphereVm's J, unlocked), using the
+// structure of its J^T W_A J. For W_A = diag(a, a, a, b, b, b) (the thesis's
+// identity among them) and any pivot orientation, eq. 3.31 gives, with
+// s2, c2 the sine and cosine of the polar angle,
+//   J^T W_A J = [a L^2 s2^2 + b, 0, -b c2; 0, a L^2 + b, 0; -b c2, 0, b],
+// whose eigenvalues are a L^2 + b and those of the 2 x 2 block of joints 1
+// and 3, all by square roots, and whose inverse is a 2 x 2 inverse and a
+// division. Where that block is as far from singular as the general path's
+// Cholesky branch asks (rho <= 1e-8 s_min), f is computed so; otherwise, and
+// for any other W_A, it returns project_motion_force(J, ...). The same f as
+// project_motion_force to rounding (J^T W_A J is formed from the angles
+// instead of from J's entries).
+ProjectionResult project_motion_force_sphere(const VmJacobian& J,
+                                             double length, double sin_polar,
+                                             double cos_polar, const Vec6& W_A,
+                                             const Vec6& g,
+                                             double singular_rcond,
+                                             double damping, Vec6* f);
+
 }  // namespace vmh
 
 #endif  // VMHAPTICS_CONTROLLER_CONTROL_LAW_H_

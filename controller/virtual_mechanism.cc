@@ -1,5 +1,6 @@
 #include "controller/virtual_mechanism.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -495,6 +496,91 @@ bool SurfaceVm::aligned(const RmPose& rm, VmAngles* theta) const {
   const Vec3 tip = rm.p - length_ * a - mount_.origin;
   (*theta)[0] = mount_.R.col(0).dot(tip);
   (*theta)[1] = mount_.R.col(1).dot(tip);
+  return true;
+}
+
+bool SurfaceVm::placement_minimum(const RmPose& rm, double w_pos,
+                                  double w_ornt, bool contact_held,
+                                  VmAngles* theta) const {
+  if (!(w_ornt > 0.0) || !(w_pos >= 0.0)) return false;
+  const double na = rm.axis.norm();
+  if (!(na > kPoleSin)) return false;
+  const Vec3 a = rm.axis / na;
+  // the reference direction e (n, or d toward the RM from a held contact)
+  // and the constants of the position term
+  Vec3 e;
+  double h = 0.0, dn = 0.0;
+  if (contact_held) {
+    const Vec3 d = rm.p - contact(*theta);
+    dn = d.norm();
+    if (!(dn > kDegenerateFraction * length_)) return false;
+    e = d / dn;
+  } else {
+    e = normal();
+    h = e.dot(rm.p - mount_.origin);
+  }
+  // t: the unit tangent from e toward a; psi_a the angle between them
+  const double ca = e.dot(a);
+  const Vec3 ta = a - ca * e;
+  const double sa = ta.norm();
+  if (!(sa > 1e-9)) return false;
+  const Vec3 t = ta / sa;
+  const double psi_a = std::atan2(sa, ca);
+  // start from the current probe's angle to e
+  const SinCos t_alpha = sin_cos((*theta)[2]), t_beta = sin_cos((*theta)[3]);
+  const Vec3 u0 = mount_.R * Vec3(t_beta.c, t_beta.s * t_alpha.c,
+                                  t_beta.s * t_alpha.s);
+  double psi = std::atan2(u0.cross(e).norm(), u0.dot(e));
+  const double L = length_;
+  // g(psi) up to a constant, g', g''
+  auto cost = [&](double x, double* g1, double* g2) {
+    const SinCos sc = sin_cos(x);
+    const double o = x - psi_a;
+    if (contact_held) {
+      const double k = w_pos * L * dn;
+      if (g1 != nullptr) *g1 = 2.0 * (k * sc.s + w_ornt * o);
+      if (g2 != nullptr) *g2 = 2.0 * (k * sc.c + w_ornt);
+      return -2.0 * k * sc.c + w_ornt * o * o;
+    }
+    const double rn = h - L * sc.c;
+    if (g1 != nullptr) *g1 = 2.0 * (w_pos * rn * L * sc.s + w_ornt * o);
+    if (g2 != nullptr) {
+      *g2 = 2.0 * (w_pos * L * (L * sc.s * sc.s + rn * sc.c) + w_ornt);
+    }
+    return w_pos * rn * rn + w_ornt * o * o;
+  };
+  double g1 = 0.0, g2 = 0.0;
+  double g = cost(psi, &g1, &g2);
+  bool done = false;
+  for (int it = 0; it < 50 && !done; ++it) {
+    // Newton where g is convex, else a bounded descent step; halved until
+    // g does not increase; psi stays in [0, pi]
+    double step = g2 > 0.0 ? -g1 / g2 : (g1 > 0.0 ? -0.25 : 0.25);
+    step = std::clamp(step, -0.5, 0.5);
+    for (int half = 0; half < 40; ++half) {
+      const double x = std::clamp(psi + step, 0.0, kPi);
+      const double gx = cost(x, nullptr, nullptr);
+      if (gx <= g) {
+        done = std::abs(x - psi) < 1e-15 * (1.0 + std::abs(psi)) ||
+               std::abs(step) < 1e-13;
+        psi = x;
+        g = cost(psi, &g1, &g2);
+        break;
+      }
+      step *= 0.5;
+      if (half == 39) done = true;
+    }
+  }
+  if (!std::isfinite(psi)) return false;
+  const SinCos sp = sin_cos(psi);
+  const Vec3 u = sp.c * e + sp.s * t;
+  surface_angles(mount_.R.transpose() * u, theta);
+  if (!contact_held) {
+    const Vec3 tip = rm.p - L * u - mount_.origin;
+    (*theta)[0] = mount_.R.col(0).dot(tip);
+    (*theta)[1] = mount_.R.col(1).dot(tip);
+  }
+  normalize(theta);
   return true;
 }
 

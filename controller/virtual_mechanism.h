@@ -176,6 +176,19 @@ class VirtualMechanism {
   virtual ContactState contact_state(const Vec3& f_N, double mu,
                                      bool unilateral, bool sticking) const;
 
+  // Where the VM can say so in closed form, the minimiser of the placement
+  // cost r^T W r (W = diag(w_pos I, w_ornt I), r = placement_residual) near
+  // *theta, for a Gauss-Newton placement to start from: true and *theta
+  // replaced; false (nothing written) where the VM has no such form or it
+  // is undefined. `contact_held`: the stick joints are locked. None by
+  // default.
+  virtual bool placement_minimum(const RmPose& rm, double w_pos,
+                                 double w_ornt, bool contact_held,
+                                 VmAngles* theta) const {
+    (void)rm, (void)w_pos, (void)w_ornt, (void)contact_held, (void)theta;
+    return false;
+  }
+
   // a VmAngles of size dof(), zero
   VmAngles zero_angles() const;
   // the angles before any placement (zero, or the surface's upright probe)
@@ -270,6 +283,19 @@ class SurfaceVm final : public VirtualMechanism {
                              bool sticking) const override;
   // the probe upright (alpha = beta = pi/2), the contact at the origin
   VmAngles rest_angles() const override;
+  // The placement cost reduces to one angle (docs/control.md): with the
+  // contact free, the best contact leaves only the normal part of the
+  // position residual, h - L u.n (h the RM's height over the plane); with it
+  // held at c, the position part depends on u only through u.d (d = p - c).
+  // Either way, for a fixed angle psi between u and n (or d), the angle phi
+  // between u and the stylus axis is smallest, |psi - psi_a|, with u in the
+  // plane of n (or d) and the axis. So u = cos psi n + sin psi t, and psi
+  // minimises w_pos (h - L cos psi)^2 + w_ornt (psi - psi_a)^2 (free), or
+  // -2 w_pos L |d| cos psi + w_ornt (psi - psi_a)^2 (held), by safeguarded
+  // Newton from *theta's psi. False where w_ornt = 0 (a family of minima),
+  // the axis lies along n (or d) (no plane), or the RM sits on the contact.
+  bool placement_minimum(const RmPose& rm, double w_pos, double w_ornt,
+                         bool contact_held, VmAngles* theta) const override;
 
   // the contact point (device frame) for theta
   Vec3 contact(const VmAngles& theta) const;

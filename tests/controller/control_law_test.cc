@@ -371,6 +371,59 @@ TEST(ActiveColumns, PicksUnlockedColumnsInOrder) {
   EXPECT_TRUE(out == J);
 }
 
+// project_motion_force_sphere against the general path on the sphere's own
+// J: the same f to rounding (relative 1e-12 of |g|, observed ~1e-14), the
+// same rcond (1e-8 relative, the general path's closed-form eigenvalues
+// carry trigonometric rounding), the same flag; near the pole and for a W_A
+// that is not block-uniform it is the general path itself.
+TEST(ProjectMotionForceSphere, EqualsTheGeneralProjection) {
+  std::mt19937 rng(18);
+  int structured = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    VmMount mount;
+    mount.origin = random_vec6(&rng, 100.0).head<3>();
+    mount.R = Eigen::AngleAxisd(uniform(&rng, 0.0, kPi), random_unit(&rng))
+                  .toRotationMatrix();
+    const double L = trial % 2 == 0 ? 50.0 : uniform(&rng, 0.1, 200.0);
+    const SphereVm vm(mount, L);
+    VmAngles theta = random_theta(vm, &rng);
+    // a quarter of them within 1e-3 .. 1e-9 rad of a pole
+    if (trial % 4 == 3) {
+      theta[1] = std::pow(10.0, uniform(&rng, -9.0, -3.0)) +
+                 (trial % 8 == 7 ? kPi : 0.0);
+    }
+    VmJacobian J;
+    vm.jacobian(theta, &J);
+    Vec6 W = Vec6::Ones();
+    if (trial % 3 == 1) {
+      const double a = std::pow(10.0, uniform(&rng, -1.0, 1.0));
+      const double b = std::pow(10.0, uniform(&rng, -1.0, 1.0));
+      W << a, a, a, b, b, b;
+    } else if (trial % 3 == 2) {
+      W = random_weights(&rng);
+    }
+    const Vec6 g = random_vec6(&rng, 10.0);
+    Vec6 f_general, f_sphere;
+    const ProjectionResult pg = project_motion_force(
+        J, W, g, kSingularRcond, kDamping, &f_general);
+    const ProjectionResult ps = project_motion_force_sphere(
+        J, L, std::sin(theta[1]), std::cos(theta[1]), W, g, kSingularRcond,
+        kDamping, &f_sphere);
+    const bool near_pole = std::abs(std::sin(theta[1])) < 1e-3;
+    if (!near_pole && trial % 3 != 2) ++structured;
+    EXPECT_LE((f_sphere - f_general).norm(), 1e-12 * g.norm() / pg.rcond)
+        << "trial " << trial;
+    if (!near_pole) {
+      EXPECT_LE((f_sphere - f_general).norm(), 1e-12 * g.norm())
+          << "trial " << trial;
+    }
+    EXPECT_NEAR(ps.rcond, pg.rcond, 1e-8 * pg.rcond + 1e-15)
+        << "trial " << trial;
+    EXPECT_EQ(ps.singular, pg.singular) << "trial " << trial;
+  }
+  EXPECT_GT(structured, 1000);
+}
+
 // ---------------------------------------------------------------- placement
 }  // namespace
 }  // namespace vmh
