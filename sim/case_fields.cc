@@ -276,9 +276,11 @@ const std::vector<ParamSpec>& case_fields() {
           .flag01(),
       numeric("sim", "duration_s", 1, "20", "s",
               "simulated time of a run, at least one servo period; at most "
-              "an hour, as `run` holds its whole trace in memory (0.86 kB a "
-              "tick, 3.1 GB for 3600 s at 1 kHz; about twice that with "
-              "--out, which builds trace.csv in memory too)",
+              "an hour. `run` writes trace.csv as it goes (about 0.55 kB a "
+              "tick, 2 GB for 3600 s at 1 kHz; --out's disk is checked for "
+              "room first) and keeps at most 60,000 ticks in memory for the "
+              "claims and figures (every k-th beyond: summary.json's "
+              "measured_every_ticks)",
               [](CaseParams* p, const ParamValue& v) {
                 p->sim.duration_s = item(v);
               })

@@ -83,42 +83,51 @@ double mean_of(const std::vector<double>& v) {
 
 }  // namespace
 
-RunMetrics run_metrics(const std::vector<TraceRow>& rows,
-                       const ClosedLoop& loop) {
-  RunMetrics m;
-  const auto& segs = loop.script().segments();
-  const double T = loop.controller_params().servo_period_s;
-  double sum_d2 = 0.0, sum_xv2 = 0.0, sum_f = 0.0, sum_f2 = 0.0;
-  int n = 0;
-  for (const TraceRow& r : rows) {
-    ++m.ticks;
-    const ControlStatus s = r.out.status;
-    if (s & kStatusForceSaturated) ++m.force_saturated_ticks;
-    if (s & kStatusTorqueSaturated) ++m.torque_saturated_ticks;
-    if (is_fault(s) || r.servo.zeroed) ++m.fault_ticks;
-    if (s & kStatusPlacementNotConverged) ++m.placement_not_converged_ticks;
-    m.max_placement_iterations =
-        std::max(m.max_placement_iterations, r.out.placement_iterations);
-    // the settle at the start is not part of the experiment
-    if (segs.size() > 1 && r.segment == 0) continue;
-    ++n;
-    const double d = r.d_path_mm;
-    const double f = r.out.force_device_N.norm();
-    sum_d2 += d * d;
-    sum_xv2 += (r.out.x_v_mm - r.out.p_rm_mm).squaredNorm();
-    sum_f += f;
-    sum_f2 += f * f;
-    m.max_path_error_mm = std::max(m.max_path_error_mm, d);
-    m.max_force_N = std::max(m.max_force_N, f);
-    if (d <= kOnPathMm) m.time_on_path_s += T;
-  }
-  if (n > 0) {
-    m.rms_path_error_mm = std::sqrt(sum_d2 / n);
-    m.rms_xv_error_mm = std::sqrt(sum_xv2 / n);
-    m.mean_force_N = sum_f / n;
-    m.rms_force_N = std::sqrt(sum_f2 / n);
+MetricsAccumulator::MetricsAccumulator(const ClosedLoop& loop)
+    : T_s_(loop.controller_params().servo_period_s),
+      has_settle_(loop.script().segments().size() > 1) {}
+
+void MetricsAccumulator::add(const TraceRow& r) {
+  RunMetrics& m = m_;
+  ++m.ticks;
+  const ControlStatus s = r.out.status;
+  if (s & kStatusForceSaturated) ++m.force_saturated_ticks;
+  if (s & kStatusTorqueSaturated) ++m.torque_saturated_ticks;
+  if (is_fault(s) || r.servo.zeroed) ++m.fault_ticks;
+  if (s & kStatusPlacementNotConverged) ++m.placement_not_converged_ticks;
+  m.max_placement_iterations =
+      std::max(m.max_placement_iterations, r.out.placement_iterations);
+  // the settle at the start is not part of the experiment
+  if (has_settle_ && r.segment == 0) return;
+  ++n_;
+  const double d = r.d_path_mm;
+  const double f = r.out.force_device_N.norm();
+  sum_d2_ += d * d;
+  sum_xv2_ += (r.out.x_v_mm - r.out.p_rm_mm).squaredNorm();
+  sum_f_ += f;
+  sum_f2_ += f * f;
+  m.max_path_error_mm = std::max(m.max_path_error_mm, d);
+  m.max_force_N = std::max(m.max_force_N, f);
+  if (d <= kOnPathMm) m.time_on_path_s += T_s_;
+}
+
+RunMetrics MetricsAccumulator::result() const {
+  RunMetrics m = m_;
+  if (n_ > 0) {
+    const double n = static_cast<double>(n_);
+    m.rms_path_error_mm = std::sqrt(sum_d2_ / n);
+    m.rms_xv_error_mm = std::sqrt(sum_xv2_ / n);
+    m.mean_force_N = sum_f_ / n;
+    m.rms_force_N = std::sqrt(sum_f2_ / n);
   }
   return m;
+}
+
+RunMetrics run_metrics(const std::vector<TraceRow>& rows,
+                       const ClosedLoop& loop) {
+  MetricsAccumulator acc(loop);
+  for (const TraceRow& r : rows) acc.add(r);
+  return acc.result();
 }
 
 void merge_sides(std::vector<Claim>* first, const SideLabel& where_first,

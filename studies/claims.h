@@ -9,6 +9,7 @@
 #define VMHAPTICS_STUDIES_CLAIMS_H_
 
 #include <optional>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -105,6 +106,23 @@ struct RunMetrics {
 // within this distance (mm) the RM counts as on the path for time_on_path_s
 inline constexpr double kOnPathMm = 1.0;
 
+// RunMetrics over a run's ticks, one at a time (memory does not grow with
+// the run).
+class MetricsAccumulator {
+ public:
+  explicit MetricsAccumulator(const sim::ClosedLoop& loop);
+  void add(const sim::TraceRow& r);
+  RunMetrics result() const;
+
+ private:
+  double T_s_;
+  bool has_settle_;
+  RunMetrics m_;
+  std::int64_t n_ = 0;
+  double sum_d2_ = 0.0, sum_xv2_ = 0.0, sum_f_ = 0.0, sum_f2_ = 0.0;
+};
+
+// RunMetrics over all of `rows`.
 RunMetrics run_metrics(const std::vector<sim::TraceRow>& rows,
                        const sim::ClosedLoop& loop);
 

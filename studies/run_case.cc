@@ -1,6 +1,7 @@
 #include "studies/run_case.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <memory>
 
 #include "controller/device_frame.h"
 #include "report/output_file.h"
@@ -29,38 +31,91 @@ void put(std::string* s, double x) {
   *s += buf;
 }
 
-std::string trace_csv(const std::vector<TraceRow>& rows, const ClosedLoop& loop) {
-  const int dof = loop.controller().mechanism().dof();
+// trace.csv's header line
+std::string trace_header(const ClosedLoop& loop) {
+  const std::vector<std::string> cols =
+      trace_columns(loop.controller().mechanism().dof());
   std::string s;
-  const std::vector<std::string> cols = trace_columns(dof);
   for (std::size_t i = 0; i < cols.size(); ++i) {
     s += cols[i] + (i + 1 < cols.size() ? "," : "\n");
   }
-  const auto& segs = loop.script().segments();
-  s.reserve(rows.size() * 900);
-  for (const TraceRow& r : rows) {
-    const ControlOutput& o = r.out;
-    put(&s, r.t_s);
-    for (int i = 0; i < 6; ++i) put(&s, r.q_dh[i]);
-    for (int i = 0; i < 3; ++i) put(&s, o.p_rm_mm[i]);
-    for (int i = 0; i < 3; ++i) put(&s, o.axis_rm[i]);
-    for (int i = 0; i < dof; ++i) put(&s, i < o.theta_v.size() ? o.theta_v[i] : 0.0);
-    for (int i = 0; i < dof; ++i) put(&s, i < o.theta_r.size() ? o.theta_r[i] : 0.0);
-    for (int i = 0; i < 3; ++i) put(&s, o.x_v_mm[i]);
-    for (int i = 0; i < 3; ++i) put(&s, o.x_r_mm[i]);
-    for (int i = 0; i < 6; ++i) put(&s, o.e[i]);
-    for (int i = 0; i < 6; ++i) put(&s, o.f_motion[i]);
-    for (int i = 0; i < 3; ++i) put(&s, o.force_device_N[i]);
-    for (int i = 0; i < 3; ++i) put(&s, o.tau_motor_Nm[i]);
-    for (int i = 0; i < 3; ++i) put(&s, r.motor_torque_Nm[i]);
-    for (int i = 0; i < 3; ++i) put(&s, r.hand_target.p_mm[i]);
-    for (int i = 0; i < 3; ++i) put(&s, r.hand_force_N[i]);
-    put(&s, r.d_path_mm);
-    s += std::to_string(o.status) + ",";
-    s += segs[static_cast<std::size_t>(r.segment)].name + "\n";
-  }
   return s;
 }
+
+// one row of trace.csv, appended to *out
+void append_trace_row(std::string* out, const TraceRow& r, const ClosedLoop& loop) {
+  std::string& s = *out;
+  const int dof = loop.controller().mechanism().dof();
+  const auto& segs = loop.script().segments();
+  const ControlOutput& o = r.out;
+  put(&s, r.t_s);
+  for (int i = 0; i < 6; ++i) put(&s, r.q_dh[i]);
+  for (int i = 0; i < 3; ++i) put(&s, o.p_rm_mm[i]);
+  for (int i = 0; i < 3; ++i) put(&s, o.axis_rm[i]);
+  for (int i = 0; i < dof; ++i) put(&s, i < o.theta_v.size() ? o.theta_v[i] : 0.0);
+  for (int i = 0; i < dof; ++i) put(&s, i < o.theta_r.size() ? o.theta_r[i] : 0.0);
+  for (int i = 0; i < 3; ++i) put(&s, o.x_v_mm[i]);
+  for (int i = 0; i < 3; ++i) put(&s, o.x_r_mm[i]);
+  for (int i = 0; i < 6; ++i) put(&s, o.e[i]);
+  for (int i = 0; i < 6; ++i) put(&s, o.f_motion[i]);
+  for (int i = 0; i < 3; ++i) put(&s, o.force_device_N[i]);
+  for (int i = 0; i < 3; ++i) put(&s, o.tau_motor_Nm[i]);
+  for (int i = 0; i < 3; ++i) put(&s, r.motor_torque_Nm[i]);
+  for (int i = 0; i < 3; ++i) put(&s, r.hand_target.p_mm[i]);
+  for (int i = 0; i < 3; ++i) put(&s, r.hand_force_N[i]);
+  put(&s, r.d_path_mm);
+  s += std::to_string(o.status) + ",";
+  s += segs[static_cast<std::size_t>(r.segment)].name + "\n";
+}
+
+// trace.csv written as the run goes, a buffer of rows at a time, so that
+// the trace's length is bounded by the disk, not by memory. Every failure
+// (open, write, a full disk, close) throws std::runtime_error naming the
+// file and the OS's reason.
+class TraceWriter {
+ public:
+  // writes `path`; errors name `shown` (where the file will be once its set
+  // is in place)
+  TraceWriter(const std::string& path, std::string shown, const ClosedLoop& loop)
+      : path_(std::move(shown)), loop_(loop) {
+    f_ = std::fopen(path.c_str(), "wb");
+    if (!f_) fail();
+    buf_ = trace_header(loop_);
+  }
+  ~TraceWriter() {
+    if (f_) std::fclose(f_);
+  }
+  TraceWriter(const TraceWriter&) = delete;
+  TraceWriter& operator=(const TraceWriter&) = delete;
+
+  void add(const TraceRow& r) {
+    append_trace_row(&buf_, r, loop_);
+    if (buf_.size() >= kFlushBytes) flush();
+  }
+  void close() {
+    flush();
+    std::FILE* f = f_;
+    f_ = nullptr;
+    if (std::fclose(f) != 0) fail();
+  }
+
+ private:
+  static constexpr std::size_t kFlushBytes = std::size_t{1} << 18;
+  void flush() {
+    if (!buf_.empty() &&
+        std::fwrite(buf_.data(), 1, buf_.size(), f_) != buf_.size()) {
+      fail();
+    }
+    buf_.clear();
+  }
+  [[noreturn]] void fail() const {
+    throw std::runtime_error(path_ + ": " + std::strerror(errno));
+  }
+  std::string path_;
+  const ClosedLoop& loop_;
+  std::FILE* f_ = nullptr;
+  std::string buf_;
+};
 
 }  // namespace
 
@@ -171,6 +226,25 @@ std::string resolve_scene(const std::string& case_or_path, std::string* name) {
                  ") nor an existing scene file");
 }
 
+double trace_bytes_bound(std::int64_t ticks, std::size_t columns) {
+  // "%.9g," of a negative number with an exponent is 16 bytes at most
+  return static_cast<double>(ticks) * static_cast<double>(columns) * 16.0;
+}
+
+void check_trace_fits(const std::string& dir, std::int64_t ticks,
+                      std::size_t columns, std::uintmax_t available_B) {
+  // a tenth more for the summary and the figures
+  const double need_B = 1.1 * trace_bytes_bound(ticks, columns);
+  if (need_B <= static_cast<double>(available_B)) return;
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "'%s': the trace of %lld ticks may need %.3g MB and the disk "
+                "has %.3g MB free; shorten duration_s or free space",
+                dir.c_str(), static_cast<long long>(ticks), need_B * 1e-6,
+                static_cast<double>(available_B) * 1e-6);
+  throw SimError(buf);
+}
+
 std::vector<std::string> trace_columns(int vm_dof) {
   std::vector<std::string> c = {"t_s"};
   for (int i = 1; i <= 6; ++i) c.push_back("q" + std::to_string(i) + "_rad");
@@ -205,37 +279,57 @@ std::vector<std::string> trace_columns(int vm_dof) {
 
 namespace {
 
+// every how many ticks a run keeps one for its claims, metrics and figures
+int kept_every(const ClosedLoop& loop) {
+  const std::int64_t n = loop.ticks_per_run();
+  return static_cast<int>(
+      std::max<std::int64_t>(1, (n + kMaxKeptTicks - 1) / kMaxKeptTicks));
+}
+
 // the loop to its end, with the reference controller where the case's
-// claims compare with case 2's gains
-std::vector<TraceRow> run_to_end(ClosedLoop* loop, const StopFn& stop) {
+// claims compare with case 2's gains. Every tick goes to `trace` (if set) as
+// it is made; every kept_every()-th is kept and returned, so memory stays
+// flat however long the run.
+std::vector<TraceRow> run_to_end(ClosedLoop* loop, const StopFn& stop,
+                                 TraceWriter* trace = nullptr,
+                                 MetricsAccumulator* metrics = nullptr) {
   const int thesis_case = loop->config().thesis_case;
   if (auto ref = reference_params(thesis_case, loop->controller_params())) {
     loop->set_reference(*ref);
   }
+  const int every = kept_every(*loop);
   // with servo jitter the number of ticks is not known ahead: run until the
   // simulated time is up
   std::vector<TraceRow> rows;
-  try {
-    rows.reserve(static_cast<std::size_t>(loop->ticks_per_run()));
-  } catch (const std::exception&) {
-    char gb[32];
-    std::snprintf(gb, sizeof gb, "%.3g",
-                  static_cast<double>(loop->ticks_per_run()) *
-                      static_cast<double>(sizeof(TraceRow)) * 1e-9);
-    throw std::runtime_error("the trace of " +
-                             std::to_string(loop->ticks_per_run()) +
-                             " ticks (" + gb +
-                             " GB) does not fit in memory; shorten duration_s");
-  }
+  rows.reserve(static_cast<std::size_t>(std::min<std::int64_t>(
+      kMaxKeptTicks + 1, loop->ticks_per_run() / every + 1)));
+  TraceRow row;
+  std::int64_t n = 0;
   // a bad physics state (NaN, inf or beyond 1e10, which MuJoCo resets)
   // ends the run at the end of its tick: a failure (exit 1), not a result
   while (!loop->finished()) {
     if (stop && stop()) throw Interrupted();
-    rows.emplace_back();
-    loop->tick(&rows.back());
+    loop->tick(&row);
     loop->throw_if_physics_fault();
+    if (trace) trace->add(row);
+    if (metrics) metrics->add(row);
+    if (n++ % every == 0) rows.push_back(row);
   }
   return rows;
+}
+
+// Refuses (SimError, before any simulation) a trace.csv the disk under
+// `dir` cannot hold (check_trace_fits).
+void check_space_for_trace(const std::string& dir, const ClosedLoop& loop) {
+  std::error_code ec;
+  fs::path probe = fs::absolute(dir, ec);
+  while (!probe.empty() && !fs::exists(probe, ec)) probe = probe.parent_path();
+  const fs::space_info space =
+      fs::space(probe.empty() ? fs::path(".") : probe, ec);
+  if (ec) return;  // unknown: the writes themselves will tell
+  check_trace_fits(dir, loop.ticks_per_run(),
+                   trace_columns(loop.controller().mechanism().dof()).size(),
+                   space.available);
 }
 
 // "name=a,b,c": a --set override with every digit of the values
@@ -263,13 +357,30 @@ CaseResult run_case(const std::string& name, const std::string& scene,
   MujocoWarningScope mujoco_messages;
   ClosedLoop loop(scene, overrides, omni_model_hook(model_file));
   const int thesis_case = loop.config().thesis_case;
+  // the files go, as one set, into a private folder renamed into place when
+  // all are written (the previous set, if any, is left whole until then);
+  // trace.csv is written into it as the run goes
+  std::unique_ptr<report::OutputSet> set;
+  std::unique_ptr<TraceWriter> trace;
+  if (!out_dir.empty()) {
+    check_space_for_trace(out_dir, loop);
+    set = std::make_unique<report::OutputSet>((fs::path(out_dir) / name).string());
+    trace = std::make_unique<TraceWriter>(
+        (fs::path(set->temp_dir()) / "trace.csv").string(),
+        (fs::path(out_dir) / name / "trace.csv").string(), loop);
+  }
+  result.kept_every = kept_every(loop);
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<TraceRow> rows = run_to_end(&loop, should_stop);
+  MetricsAccumulator metrics(loop);
+  const std::vector<TraceRow> rows =
+      run_to_end(&loop, should_stop, trace.get(), &metrics);
   const auto stop = std::chrono::steady_clock::now();
+  if (trace) trace->close();
   result.wall_time_s = std::chrono::duration<double>(stop - start).count();
   result.simulated_s = loop.time_s();
 
-  result.metrics = run_metrics(rows, loop);
+  // over every tick; the claims over the kept ones
+  result.metrics = metrics.result();
   result.claims = evaluate_claims(thesis_case, rows, loop);
   // the same script on the other sides of the pivot: mirrored left to right
   // (script_dir's and script_axis's x negated), from below the pivot
@@ -367,6 +478,7 @@ CaseResult run_case(const std::string& name, const std::string& scene,
       {"simulated_s", result.simulated_s},
       {"wall_time_s", result.wall_time_s},
       {"realtime_factor", result.simulated_s / std::max(result.wall_time_s, 1e-9)},
+      {"measured_every_ticks", result.kept_every},
       {"physics",
        {{"step_s", model->opt.timestep},
         {"substeps_per_tick", loop.substeps()},
@@ -381,20 +493,16 @@ CaseResult run_case(const std::string& name, const std::string& scene,
       {"partial_claims", result.partial_claims},
   };
 
-  if (!out_dir.empty()) {
-    // the four files as one set: a private folder, renamed into place when
-    // all are written (the previous set, if any, is left whole until then)
-    report::OutputSet set((fs::path(out_dir) / name).string());
+  if (set) {
     const auto put_file = [&](const char* file, const std::string& text) {
       if (should_stop && should_stop()) throw Interrupted();
-      set.write(file, text);
+      set->write(file, text);
     };
-    put_file("trace.csv", trace_csv(rows, loop));
     put_file("summary.json", result.summary.dump(2) + "\n");
     put_file("views.svg", views_svg(rows, loop));
     put_file("history.svg", history_svg(rows, loop));
     if (should_stop && should_stop()) throw Interrupted();
-    set.commit();
+    set->commit();
   }
   return result;
 }

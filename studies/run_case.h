@@ -49,6 +49,9 @@ struct CaseResult {
   // no claim fails on every side (a partial claim does not fail the run)
   bool all_claims_pass = true;
   int partial_claims = 0;  // claims that hold on some sides only
+  // the claims, metrics and figures are measured on every kept_every-th
+  // tick (1 up to 60,000 ticks; trace.csv has every tick)
+  int kept_every = 1;
 };
 
 // Polled between ticks and before the outputs are written: true asks the
@@ -57,6 +60,21 @@ using StopFn = std::function<bool()>;
 struct Interrupted : std::runtime_error {
   Interrupted() : std::runtime_error("interrupted") {}
 };
+
+// An upper bound on trace.csv's size for `ticks` rows of `columns` columns
+// (bytes).
+double trace_bytes_bound(std::int64_t ticks, std::size_t columns);
+// Throws SimError naming `dir`, the bytes needed and the bytes available
+// when a trace of `ticks` rows (trace_bytes_bound, and a tenth more for the
+// other files) does not fit in `available_B`. run_case calls it with the
+// free space of --out's disk before any simulation.
+void check_trace_fits(const std::string& dir, std::int64_t ticks,
+                      std::size_t columns, std::uintmax_t available_B);
+
+// The ticks run_case keeps in memory for the claims, metrics and figures,
+// at most; a longer run keeps every k-th (CaseResult::kept_every) and
+// streams every tick to trace.csv.
+constexpr std::int64_t kMaxKeptTicks = 60000;
 
 // Runs `scene` (with `overrides`) for its duration and, if out_dir is not
 // empty, writes out_dir/<name>/{trace.csv, summary.json, views.svg,

@@ -8,6 +8,8 @@
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "sim/mujoco_messages.h"
@@ -68,6 +70,62 @@ TEST(RunCase, NonFinitePhysicsStopsTheRun) {
     EXPECT_NE(msg.find(case1() + ": physics went non-finite at t=0.001 s (q"),
               std::string::npos)
         << msg;
+  }
+}
+
+// A run longer than kMaxKeptTicks streams every tick to trace.csv and keeps
+// every k-th for its claims and figures, while its metrics still count every
+// tick: memory stays flat however long the run. 61 s at 1 kHz: k = 2.
+TEST(RunCase, ALongRunStreamsEveryTickAndKeepsEveryKth) {
+  const std::string out = testing::TempDir() + "vmh_long_run";
+  std::filesystem::remove_all(out);
+  const CaseResult r =
+      run_case("case1", case1(), {"duration_s=61", "script=hold"}, out);
+  EXPECT_EQ(r.kept_every, 2);
+  EXPECT_EQ(r.summary.at("measured_every_ticks"), 2);
+  EXPECT_EQ(r.metrics.ticks, 61000);
+  EXPECT_EQ(r.summary.at("metrics").at("ticks"), 61000);
+  std::ifstream f(out + "/case1/trace.csv");
+  ASSERT_TRUE(f.good());
+  std::string line, last;
+  std::int64_t lines = 0;
+  while (std::getline(f, line)) {
+    ++lines;
+    last = line;
+  }
+  EXPECT_EQ(lines, 61001);  // the header and every tick
+  EXPECT_EQ(last.rfind("60.999,", 0), 0u) << last;  // t_s of the last tick
+  // nothing but the set: no temporary left beside it
+  int entries = 0;
+  for (const auto& e : std::filesystem::directory_iterator(out)) {
+    ++entries;
+    EXPECT_EQ(e.path().filename(), "case1");
+  }
+  EXPECT_EQ(entries, 1);
+  std::filesystem::remove_all(out);
+}
+
+// A 20 s run is kept whole.
+TEST(RunCase, AShortRunKeepsEveryTick) {
+  const CaseResult r = run_case("case1", case1(), {"duration_s=2"}, "");
+  EXPECT_EQ(r.kept_every, 1);
+  EXPECT_EQ(r.metrics.ticks, 2000);
+}
+
+// The space check before any simulation: a bound on trace.csv's size (16
+// bytes a column) and a tenth more, against what the disk has.
+TEST(TraceFits, RefusesATraceTheDiskCannotHoldNamingBoth) {
+  EXPECT_DOUBLE_EQ(trace_bytes_bound(20000, 55), 20000.0 * 55 * 16);
+  EXPECT_NO_THROW(check_trace_fits("out", 20000, 55, 20000u * 55u * 16u * 2u));
+  try {
+    check_trace_fits("/full/disk", 3600000, 55, 1000000000u);
+    FAIL() << "a 3.5 GB trace was let onto a 1 GB disk";
+  } catch (const sim::SimError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("'/full/disk'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("3600000 ticks"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("3.48e+03 MB"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("1e+03 MB free"), std::string::npos) << msg;
   }
 }
 
