@@ -6,7 +6,8 @@
 // refuse_empty_numbers, and the arguments are parsed, which runs the verb.
 // The outcome must be one of main()'s:
 //  - success: what the verb wrote on stdout is one JSON object (kin, ctl)
-//    whose numbers are all finite, or the parameter table (params);
+//    whose numbers are all finite (no null but where docs/outputs.md
+//    documents one), or the parameter table (params);
 //  - bad usage (exit 2): a CLI::ParseError or a vmh::cli::UsageError with a
 //    one-line message;
 //  - a run failure (exit 1): only ctl's "controller fault", with a message.
@@ -34,11 +35,18 @@
 
 namespace {
 
-// every number of a JSON document finite (a NaN or inf is written as null)
-bool all_finite(const nlohmann::json& j) {
-  if (j.is_null()) return false;
+// every number of a JSON document finite. nlohmann writes a NaN or inf as
+// null, so null is refused too, except under the keys docs/outputs.md
+// documents as null: kin ik's `nearest` when no solution is there, kin's
+// `J_pos_condition` at a singular pose
+bool all_finite(const nlohmann::json& j, const std::string& key = "") {
+  if (j.is_null()) return key == "nearest" || key == "J_pos_condition";
   if (j.is_number_float()) return std::isfinite(j.get<double>());
-  if (j.is_structured()) {
+  if (j.is_object()) {
+    for (const auto& [k, v] : j.items()) {
+      if (!all_finite(v, k)) return false;
+    }
+  } else if (j.is_array()) {
     for (const auto& v : j) {
       if (!all_finite(v)) return false;
     }
