@@ -68,19 +68,22 @@ double parse_number(const std::string& option, const std::string& text) {
   return to_number(option, text, "value");
 }
 
-void refuse_empty_numbers(CLI::App* app) {
-  const CLI::Validator non_empty(
-      [](std::string& value) {
+void refuse_empty(CLI::Option* option, const std::string& give) {
+  option->check(CLI::Validator(
+      [give](std::string& value) {
         return value.find_first_not_of(" \t") == std::string::npos
-                   ? std::string("the value is empty; give a number")
+                   ? "the value is empty; give " + give
                    : std::string();
       },
-      "", "NON_EMPTY");
+      "", "NON_EMPTY"));
+}
+
+void refuse_empty_numbers(CLI::App* app) {
   for (CLI::Option* opt : app->get_options()) {
     const std::string type = opt->get_type_name();
     if (opt->get_type_size_max() > 0 &&
         (type == "FLOAT" || type == "INT" || type == "UINT")) {
-      opt->check(non_empty);
+      refuse_empty(opt, "a number");
     }
   }
   for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) {

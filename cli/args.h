@@ -11,6 +11,7 @@
 
 namespace CLI {
 class App;
+class Option;
 }  // namespace CLI
 
 namespace vmh::cli {
@@ -32,6 +33,11 @@ double parse_number(const std::string& option, const std::string& text);
 // and UINT options, not flags) a check that refuses an empty value: CLI11
 // would read "" as 0, i.e. as the option's default. The help is unchanged.
 void refuse_empty_numbers(CLI::App* app);
+
+// The same check on one option of any type: for a text option whose empty
+// value would otherwise mean "not given" (study precision --steps "" ran the
+// whole default ladder).
+void refuse_empty(CLI::Option* option, const std::string& give = "a value");
 
 }  // namespace vmh::cli
 

@@ -85,10 +85,29 @@ void print_mujoco_warnings() {
   }
 }
 
+// control characters (an ANSI escape in an argument the message quotes) as
+// \xNN, so that an error line cannot drive the terminal
+std::string escape_controls(const std::string& s) {
+  std::string out;
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c == 0x7f) {
+      static const char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 0xf];
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
 // the one error line, after the warnings
 int fail(int code, const std::string& message, const char* prefix = "error: ") {
   print_mujoco_warnings();
-  std::cerr << "vmhaptics: " << prefix << first_line(message) << '\n';
+  std::cerr << "vmhaptics: " << prefix << escape_controls(first_line(message))
+            << '\n';
   return code;
 }
 

@@ -81,6 +81,10 @@ void run(const RunOptions& o) {
   if (o.all == !o.target.empty()) {
     throw UsageError("run: give one case or scene, or --all");
   }
+  if (o.jobs < 0) {
+    throw UsageError("--jobs: must be >= 0 (0: one per core), got " +
+                     std::to_string(o.jobs));
+  }
   std::vector<std::string> sets = o.sets;
   if (o.duration_given) {
     // checked here, before any scene is read, against duration_s's row of

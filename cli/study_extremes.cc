@@ -54,6 +54,11 @@ void print_table(const std::vector<studies::ExtremeResult>& results) {
 }
 
 void run(const ExtremesCli& o) {
+  // -5 ran on every core as if 0 had been given (issue 17)
+  if (o.jobs < 0) {
+    throw UsageError("--jobs: must be >= 0 (0: one per core), got " +
+                     std::to_string(o.jobs));
+  }
   studies::ExtremesOptions p;
   p.only = o.only;
   p.out_dir = o.out;

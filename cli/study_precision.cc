@@ -138,6 +138,15 @@ void check_against_case(const studies::PrecisionOptions& p) {
                      "period " + g(period_s) + " s, got " +
                      g(p.reference_step_s));
   }
+  // 1e-12 s divides 1 ms, but a billion steps per tick is past the closed
+  // loop's bound, which then named servo_period_s instead of the option
+  if (period_s / p.reference_step_s >
+      static_cast<double>(sim::kMaxSubstepsPerTick)) {
+    throw UsageError("--reference-step: at most " +
+                     std::to_string(sim::kMaxSubstepsPerTick) +
+                     " steps per servo period " + g(period_s) + " s, got " +
+                     g(p.reference_step_s));
+  }
   if (!(p.reference_check_step_s > p.reference_step_s) ||
       !divides(p.reference_check_step_s, period_s)) {
     throw UsageError("--reference-check-step: must be above --reference-step "
@@ -175,11 +184,17 @@ void register_study_precision(CLI::App* study) {
                   "simulated seconds from the start of the case's script "
                   "(default 3: the settle, the move off the path and the "
                   "hold there)");
-  cmd->add_option("--steps", o->steps,
-                  "physics steps h (s), comma-separated, each dividing the "
-                  "servo period (default 1e-3,5e-4,2e-4,1e-4,5e-5,2e-5,1e-5)");
-  cmd->add_option("--integrators", o->integrators,
-                  "comma-separated subset of euler,implicit,rk4 (default all)");
+  // an empty list is refused, not read as "not given" (issue 17)
+  refuse_empty(
+      cmd->add_option("--steps", o->steps,
+                      "physics steps h (s), comma-separated, each dividing "
+                      "the servo period (default "
+                      "1e-3,5e-4,2e-4,1e-4,5e-5,2e-5,1e-5)"),
+      "a list of steps");
+  refuse_empty(cmd->add_option("--integrators", o->integrators,
+                               "comma-separated subset of euler,implicit,rk4 "
+                               "(default all)"),
+               "a list of integrators");
   cmd->add_option("--reference-step", o->reference_step_s,
                   "RK4 reference step (s), default 2e-6");
   cmd->add_option("--reference-check-step", o->reference_check_step_s,

@@ -142,8 +142,12 @@ void ControllerParams::validate() const {
           "singular_rcond", "must be in (0, 1)");
   require(std::isfinite(singular_damping) && singular_damping >= 0.0,
           "singular_damping", "must be finite and >= 0");
-  require(std::isfinite(force_limit_N) && force_limit_N > 0.0,
-          "force_limit_N", "must be finite and > 0");
+  // the saturation compares |F|^2 with the limit's square, which underflows
+  // for a limit below ~1e-154 N and let a larger force through (found by
+  // tests/fuzz/controller_tick_fuzz.cc); 1 uN is far below any haptic
+  // device's resolution
+  require(std::isfinite(force_limit_N) && force_limit_N >= kMinForceLimit_N,
+          "force_limit_N", "must be finite and >= 1e-6");
 }
 
 Controller::Controller(const ControllerParams& params) : params_(params) {

@@ -113,6 +113,11 @@ struct Gains {
 // position gain's unit, N/mm, so K_ornt is in N mm/rad.
 double thesis_orientation_gain(double multiple_N_per_mm, double length_mm);
 
+// The smallest force limit ControllerParams::validate accepts (N): below
+// ~1e-154 N the limit's square underflows and the saturation could not hold
+// it.
+inline constexpr double kMinForceLimit_N = 1e-6;
+
 struct ControllerParams {
   OmniParams omni;
   VmParams vm;
@@ -134,7 +139,7 @@ struct ControllerParams {
   // singularity, so the threshold sits well below those.
   double singular_rcond = 1e-10;
   double singular_damping = 1e-13;
-  // saturation; defaults from OmniParams
+  // saturation; defaults from OmniParams; at least kMinForceLimit_N
   double force_limit_N = OmniParams().max_force_N;
 
   // Throws std::invalid_argument naming the first bad field.

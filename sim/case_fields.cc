@@ -227,8 +227,8 @@ const std::vector<ParamSpec>& case_fields() {
               [](CaseParams* p, const ParamValue& v) {
                 p->controller.force_limit_N = item(v);
               })
-          .positive()
-          .at_most(3.3)
+          // from the controller's smallest (kMinForceLimit_N)
+          .in_range(kMinForceLimit_N, 3.3)
           .source("the PHANTOM Omni's rated peak force at the nominal pose "
                   "(docs/sources.md, 7)")
           .ctl("--force-limit-N"),

@@ -215,9 +215,21 @@ std::string resolve_scene(const std::string& case_or_path, std::string* name) {
       return (fs::path(models_dir()) / c.scene).string();
     }
   }
-  if (fs::exists(case_or_path)) {
+  // without throwing: a symlink loop or a name too long for the file
+  // system is a bad argument (SimError), not a failure; and only a regular
+  // file is a scene (a FIFO would block the loader forever)
+  std::error_code ec;
+  const fs::file_status st = fs::status(case_or_path, ec);
+  if (!ec && fs::is_regular_file(st)) {
     *name = fs::path(case_or_path).stem().string();
     return case_or_path;
+  }
+  if (!ec && fs::exists(st)) {
+    throw SimError("'" + case_or_path +
+                   "' is not a regular file (a scene is an MJCF file)");
+  }
+  if (ec && ec != std::errc::no_such_file_or_directory) {
+    throw SimError("'" + case_or_path + "': " + ec.message());
   }
   std::string known;
   for (const CaseEntry& c : thesis_cases()) known += std::string(" ") + c.name;

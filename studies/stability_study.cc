@@ -90,8 +90,9 @@ void validate(const StabilityParams& p) {
     bad("--damping", "the physical damping b must be >= 0 N s/m",
         p.damping_Ns_per_m);
   }
-  if (!std::isfinite(p.servo_period_s) || !(p.servo_period_s > 0.0)) {
-    bad("--servo-period", "the servo period T must be > 0 s",
+  if (!(p.servo_period_s >= kStudyMinServoPeriod_s &&
+        p.servo_period_s <= kStudyMaxServoPeriod_s)) {
+    bad("--servo-period", "the servo period T must be in [1e-05, 1] s",
         p.servo_period_s);
   }
   if (!std::isfinite(p.virtual_damping_Ns_per_m) ||

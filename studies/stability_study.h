@@ -83,11 +83,16 @@ struct StabilityParams {
 };
 
 // Throws SimError naming the command-line option when a value is out of
-// range: m > 0, b >= 0, T > 0, B >= 0, b + B > 0 (else no K is stable),
+// range: m > 0, b >= 0, T in [1e-5, 1] s, B >= 0, b + B > 0 (else no K is stable),
 // 0 <= n <= kStudyMaxDelayTicks, 0 < h <= T with T a whole multiple of h (to
 // 1e-9 relative), and at most kMaxStepsPerTick steps per tick.
 void validate(const StabilityParams& p);
 inline constexpr int kStudyMaxDelayTicks = 20;
+// The servo periods the study takes, those of the case parameter
+// servo_period_s: a period of 1e-12 s ran for ever, one of 1e308 s
+// "found" K_crit = 0 (issue 17)
+inline constexpr double kStudyMinServoPeriod_s = 1e-5;
+inline constexpr double kStudyMaxServoPeriod_s = 1.0;
 inline constexpr int kMaxStepsPerTick = 100000;
 
 // T / h, the MuJoCo steps per servo tick (p validated).

@@ -6,6 +6,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -244,6 +245,37 @@ TEST(RunCli, TimingParametersAreBounded) {
   expect_refused("run case1 --set duration_s=",
                  {"field 'duration_s' expects 1 value(s), got 0"});
   expect_refused("run case1 --jobs ''", {"--jobs", "empty"});
+}
+
+// issue 17's hostile inputs that had no test: each is a bad argument (exit
+// 2, one line naming it), none hangs or fails as a run (exit 1)
+TEST(RunCli, HostileArgumentsAreBadUsage) {
+  expect_refused("run case1 --duration 1e5",
+                 {"--duration: field 'duration_s' must be > 0 and <= 3600, "
+                  "got 100000"});
+  expect_refused("run case1 --jobs=-5", {"--jobs", "-5"});
+  expect_refused("run case1 --set force_limit_N=1e6", {"force_limit_N"});
+  const fs::path dir = fresh_dir("hostile");
+  fs::create_directories(dir);
+  // a FIFO as the scene blocked the loader's open forever
+  const fs::path fifo = dir / "scene.xml";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  expect_refused("run " + fifo.string(), {fifo.string(), "not a regular file"});
+  // a symlink loop and a 100,000-character name threw filesystem_error
+  // (exit 1)
+  const fs::path loop = dir / "loop.xml";
+  fs::create_symlink(loop, loop);
+  expect_refused("run " + loop.string(), {loop.string()});
+  expect_refused("run " + std::string(100000, 'a') + ".xml", {"run: '"});
+}
+
+// an ANSI escape in an argument reached the terminal through the error line
+TEST(RunCli, ControlCharactersInArgumentsAreEscapedOnStderr) {
+  const auto r = run("run \"$(printf '\\033[31mcase9')\"");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("\\x1b[31mcase9"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
 }
 
 // a scene whose own step is 0 made the servo period an infinite number of

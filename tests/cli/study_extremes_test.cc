@@ -52,4 +52,13 @@ TEST(StudyExtremesCli, UnknownScenarioIsBadUsage) {
   EXPECT_EQ(r.out, "");
 }
 
+// issue 17: --jobs=-5 ran the study on every core
+TEST(StudyExtremesCli, NegativeJobsIsBadUsage) {
+  const auto r = run("study extremes --jobs=-5");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--jobs"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
+  EXPECT_EQ(r.out, "");
+}
+
 }  // namespace

@@ -80,6 +80,10 @@ TEST(StudyPrecisionCli, BadOptionsAreNamedAndWriteNothing) {
       {"--steps 3e-4", "--steps"},
       {"--steps 1e-3,abc", "--steps"},
       {"--steps 1e-6", "--steps"},
+      // issue 17: an empty list ran the default ladder
+      {"--steps ''", "--steps"},
+      {"--integrators ''", "--integrators"},
+      {"--reference-step 1e-12", "--reference-step"},
       {"--integrators euler,verlet", "--integrators"},
       {"--duration 0", "--duration"},
       {"--duration 21", "--duration"},

@@ -123,6 +123,12 @@ TEST(StudyStabilityCli, BadInputIsNamedAndExitsTwo) {
       {"study stability --mass 1 --damping -2 --servo-period 0.001",
        "--damping"},
       {"study stability --mass 1 --damping 2 --servo-period 0", "--servo-period"},
+      // issue 17: 1e-12 s ran for ever, 1e308 s printed K_crit = 0
+      {"study stability --mass 1 --damping 2 --servo-period 1e-12",
+       "--servo-period"},
+      {"study stability --mass 1 --damping 2 --servo-period 1e308",
+       "--servo-period"},
+      {ok + "--jobs=-5", "--jobs"},
       {ok + "--virtual-damping -1", "--virtual-damping"},
       {ok + "--delay-ticks 99", "--delay-ticks"},
       {ok + "--physics-step 0.0003", "--physics-step"},

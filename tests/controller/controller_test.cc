@@ -507,6 +507,23 @@ TEST(Faults, AnOverflowingForceIsANumericalFaultNotASaturation) {
   EXPECT_LT(angle_between(big.force_device_N, big.f_motion.head<3>()), 1e-9);
 }
 
+// Found by tests/fuzz/controller_tick_fuzz.cc: a force limit of 6e-161 N
+// was accepted, its square underflowed, and the commanded force came out
+// above the limit. Such limits are refused; the smallest accepted one holds.
+TEST(Saturation, ATinyForceLimitIsRefusedAndTheSmallestHolds) {
+  ControllerParams p = thesis_case(1);
+  p.force_limit_N = 5.95124e-161;
+  EXPECT_THROW(Controller c(p), std::invalid_argument);
+  p.force_limit_N = 0.5 * kMinForceLimit_N;
+  EXPECT_THROW(Controller c(p), std::invalid_argument);
+  p.force_limit_N = kMinForceLimit_N;
+  const ControlOutput out =
+      tick_once(p, pose_q(on_circle(0.4, 120.0, 30.0), Vec3(0, 0, 1)));
+  EXPECT_TRUE(out.status & kStatusForceSaturated);
+  EXPECT_LE(out.force_device_N.norm(), kMinForceLimit_N * (1.0 + 1e-12));
+  EXPECT_GT(out.force_device_N.norm(), 0.0);
+}
+
 void expect_finite(const ControlOutput& out) {
   EXPECT_TRUE(out.f_motion.allFinite());
   EXPECT_TRUE(out.e.allFinite());

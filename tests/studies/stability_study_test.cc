@@ -350,6 +350,15 @@ TEST(StabilityStudyTest, BadInputsNameTheOption) {
   with("--mass", [](StabilityParams& p) { p.mass_kg = std::nan(""); });
   with("--damping", [](StabilityParams& p) { p.damping_Ns_per_m = -1.0; });
   with("--servo-period", [](StabilityParams& p) { p.servo_period_s = -1e-3; });
+  // issue 17: 1e-12 s ran for ever, 1e308 s gave K_crit = 0
+  with("--servo-period", [](StabilityParams& p) {
+    p.servo_period_s = 1e-12;
+    p.physics_step_s = 1e-15;
+  });
+  with("--servo-period", [](StabilityParams& p) {
+    p.servo_period_s = 1e308;
+    p.physics_step_s = 1e305;
+  });
   with("--virtual-damping",
        [](StabilityParams& p) { p.virtual_damping_Ns_per_m = -0.5; });
   with("--damping, --virtual-damping", [](StabilityParams& p) {
