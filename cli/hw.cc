@@ -45,7 +45,7 @@ const HwSample* last_reading(const SessionResult& r) {
 }
 
 void probe(const RecordOptions& o) {
-  if (!(o.seconds > 0.0)) throw UsageError("hw probe: --seconds must be > 0");
+  check_seconds("hw probe: --seconds", o.seconds, 0.0, 3600.0);
   // the USB Touch: its descriptors only, no servo backend (cli/hw_usb.cc)
   const DeviceSpec spec = parse_device_spec(o.common.device);
   if (spec.backend == "usb") return usb_probe(spec.argument);
@@ -92,7 +92,8 @@ void probe(const RecordOptions& o) {
 }
 
 void record(const RecordOptions& o) {
-  if (!(o.duration_s > 0.0)) throw UsageError("hw record: --duration must be > 0");
+  // a day at most: the recording streams to disk, one row a tick
+  check_seconds("hw record: --duration", o.duration_s, 0.0, 86400.0);
   OpenedDevice dev = open_hw_device(o.common, "tour");
   SessionOptions so = session_options(o.common, "record");
   so.mode = HwMode::kRecord;
@@ -178,14 +179,14 @@ void register_hw(CLI::App* app) {
   CLI::App* p = hw->add_subcommand(
       "probe", "identification, calibration state and a second of readings");
   add_hw_common(p, &po->common);
-  p->add_option("--seconds", po->seconds, "how long to read (default 1)");
+  p->add_option("--seconds", po->seconds, "how long to read, > 0 and <= 3600 (default 1)");
   p->callback([po]() { probe(*po); });
 
   auto ro = std::make_shared<RecordOptions>();
   CLI::App* r = hw->add_subcommand(
       "record", "record the device's readings (zero force) to DIR/trace.csv");
   add_hw_common(r, &ro->common);
-  r->add_option("--duration", ro->duration_s, "seconds (default 5)");
+  r->add_option("--duration", ro->duration_s, "seconds, > 0 and <= 86400 (default 5)");
   r->add_option("--out", ro->out, "write DIR/trace.csv and DIR/meta.json");
   r->callback([ro]() { record(*ro); });
 

@@ -67,9 +67,8 @@ void calibrate_openhaptics(OpenedDevice* dev) {
 }
 
 void calibrate(const CalibrateOptions& o) {
-  if (!(o.dock_s > 1.0) || !(o.sweep_s > 1.0)) {
-    throw UsageError("hw calibrate: --dock-s and --sweep-s must be > 1");
-  }
+  check_seconds("hw calibrate: --dock-s", o.dock_s, 1.0, 600.0);
+  check_seconds("hw calibrate: --sweep-s", o.sweep_s, 1.0, 600.0);
   HwCommon c = o.common;
   c.no_calibration = true;  // fit from the raw readings alone
   OpenedDevice dev = open_hw_device(c, "dock");
@@ -210,9 +209,9 @@ void register_hw_calibrate(CLI::App* hw) {
       "$XDG_CONFIG_HOME/vmhaptics/calibration/");
   add_hw_common(cmd, &o->common);
   cmd->add_option("--dock-s", o->dock_s,
-                  "seconds for the inkwell phase (default 6)");
+                  "seconds for the inkwell phase, > 1 and <= 600 (default 6)");
   cmd->add_option("--sweep-s", o->sweep_s,
-                  "seconds for the gimbal sweep (default 10)");
+                  "seconds for the gimbal sweep, > 1 and <= 600 (default 10)");
   cmd->callback([o]() { calibrate(*o); });
 }
 

@@ -1,5 +1,8 @@
 #include "cli/hw_common.h"
 
+#include <cmath>
+#include <cstdio>
+
 #include <csignal>
 
 #include "cli/args.h"
@@ -7,6 +10,13 @@
 #include "report/output_file.h"
 
 namespace vmh::cli {
+
+void check_seconds(const std::string& what, double v, double lo_s, double hi_s) {
+  if (std::isfinite(v) && v > lo_s && v <= hi_s) return;
+  char buf[96];
+  std::snprintf(buf, sizeof buf, " must be > %g and <= %g s, got %g", lo_s, hi_s, v);
+  throw UsageError(what + buf);
+}
 
 void add_hw_common(CLI::App* cmd, HwCommon* c) {
   cmd->add_option("--device", c->device,

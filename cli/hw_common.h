@@ -27,6 +27,11 @@ struct HwCommon {
   bool quiet = false;
 };
 
+// Refuses (UsageError) a time in seconds that is not a finite number in
+// (lo_s, hi_s]: "<what> must be > lo and <= hi s, got <v>". `what` names the
+// verb and the option ("hw record: --duration").
+void check_seconds(const std::string& what, double v, double lo_s, double hi_s);
+
 // Adds --device, --hand, --fault, --emulator-fault, --model, --hd-command,
 // --no-realtime, --require-deadman, --no-calibration and --quiet to a verb.
 void add_hw_common(CLI::App* cmd, HwCommon* c);

@@ -10,6 +10,7 @@
 // --model FILE (emulator only) replaces the Omni's parameters both in the
 // emulator's scene and in the run's own model, which the claims measure on.
 // Exit codes as the other hw verbs, and 1 when a claim fails.
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -30,7 +31,8 @@ namespace {
 struct HwRunOptions {
   HwCommon common;
   std::string target;
-  double duration_s = 0.0;  // 0: the scene's
+  double duration_s = 0.0;
+  bool duration_given = false;  // else the scene's
   std::string out;
   std::vector<std::string> sets;
   double gain_scale = 1.0;
@@ -66,7 +68,9 @@ sim::TraceRow trace_row(const HwSample& h) {
 }
 
 void hw_run(const HwRunOptions& o) {
-  if (o.duration_s < 0.0) throw UsageError("hw run: --duration must be > 0");
+  if (o.duration_given) {
+    check_seconds("hw run: --duration", o.duration_s, 0.0, 3600.0);
+  }
   if (!(o.gain_scale >= 0.0) || !std::isfinite(o.gain_scale)) {
     throw UsageError("hw run: --gain-scale must be a number >= 0");
   }
@@ -78,8 +82,10 @@ void hw_run(const HwRunOptions& o) {
     throw UsageError(std::string("hw run: ") + e.what());
   }
   std::vector<std::string> sets = o.sets;
-  if (o.duration_s > 0.0) {
-    sets.push_back("duration_s=" + std::to_string(o.duration_s));
+  if (o.duration_given) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.17g", o.duration_s);
+    sets.push_back(std::string("duration_s=") + text);
   }
   // the scene's parameters, its script and the claims' geometry
   std::unique_ptr<sim::ClosedLoop> model;
@@ -191,8 +197,14 @@ void register_hw_run(CLI::App* hw) {
   add_hw_common(cmd, &o->common);
   cmd->add_option("target", o->target, "case1..case6, or a scene .xml")
       ->required();
-  cmd->add_option("--duration", o->duration_s,
-                  "seconds (default: the scene's duration_s)");
+  cmd->add_option_function<double>(
+         "--duration",
+         [o](double v) {
+           o->duration_s = v;
+           o->duration_given = true;
+         },
+         "seconds, > 0 and <= 3600 (default: the scene's duration_s)")
+      ->type_name("FLOAT");
   cmd->add_option("--out", o->out,
                   "write DIR/trace.csv, DIR/summary.json, DIR/meta.json");
   cmd->add_option("--set", o->sets,

@@ -8,6 +8,7 @@
 #include "cli/hw_usb.h"
 
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -141,6 +142,13 @@ struct CaptureArgs {
 void capture(const CaptureArgs& a) {
   usb::CaptureOptions o;
   o.where = usb_where(a.device);
+  // the capture's own check refuses <= 0 and non-finite; an hour at most
+  if (a.duration_s > 3600.0) {
+    char buf[80];
+    std::snprintf(buf, sizeof buf, "hw capture: --duration must be <= 3600 s, got %g",
+                  a.duration_s);
+    throw UsageError(buf);
+  }
   o.duration_s = a.duration_s;
   o.out_path = a.out;
   o.detach = a.detach;
@@ -224,7 +232,7 @@ void register_hw_capture(CLI::App* hw) {
       "the USB Touch's raw IN transfers, timestamped, to a text file; nothing "
       "decoded (hw/usb/README.md)");
   c->add_option("--device", a->device, "usb[:BUS-ADDR] (default: the first Touch)");
-  c->add_option("--duration", a->duration_s, "seconds to capture (> 0)")->required();
+  c->add_option("--duration", a->duration_s, "seconds to capture, > 0 and <= 3600")->required();
   c->add_option("--out", a->out, "the capture file (hw/usb/README.md, capture format)")
       ->required();
   c->add_flag("--detach", a->detach,

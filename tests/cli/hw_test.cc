@@ -189,6 +189,43 @@ TEST(HwCli, BadEmulatorOptionsAreNamed) {
   EXPECT_NE(s.err.find("nosuch_case"), std::string::npos) << s.err;
 }
 
+// Every time option of hw is bounded and checked before the device is
+// opened: exit 2 and one line naming the verb, the option, the range and
+// the value (nan and 0 are not "the default"; 1e308 is not a long run).
+TEST(HwCli, TimesOutOfRangeAreRefusedNamingTheOption) {
+  const struct {
+    const char* args;
+    const char* message;
+  } bad[] = {
+      {"hw run case1 --device emulator --duration 1e308",
+       "hw run: --duration must be > 0 and <= 3600 s, got 1e+308"},
+      {"hw run case1 --device emulator --duration nan",
+       "hw run: --duration must be > 0 and <= 3600 s, got nan"},
+      {"hw run case1 --device emulator --duration 0",
+       "hw run: --duration must be > 0 and <= 3600 s, got 0"},
+      {"hw record --device emulator --duration 1e308",
+       "hw record: --duration must be > 0 and <= 86400 s, got 1e+308"},
+      {"hw record --device emulator --duration nan",
+       "hw record: --duration must be > 0 and <= 86400 s, got nan"},
+      {"hw probe --device emulator --seconds 1e9",
+       "hw probe: --seconds must be > 0 and <= 3600 s, got 1e+09"},
+      {"hw calibrate --device emulator --dock-s inf",
+       "hw calibrate: --dock-s must be > 1 and <= 600 s, got inf"},
+      {"hw calibrate --device emulator --sweep-s 1",
+       "hw calibrate: --sweep-s must be > 1 and <= 600 s, got 1"},
+      {"hw capture --device usb --duration 1e9 --out x.bin",
+       "hw capture: --duration must be <= 3600 s, got 1e+09"},
+  };
+  for (const auto& b : bad) {
+    const auto r = run(b.args, kEnv);
+    EXPECT_EQ(r.exit_code, 2) << b.args << ": " << r.err;
+    EXPECT_EQ(r.err.substr(0, r.err.find('\n')),
+              std::string("vmhaptics: error: ") + b.message)
+        << b.args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
 TEST(HwCli, UnwritableOutputIsNamedAndTheDeviceStopped) {
   const auto r = run("hw record --device emulator --duration 1 --quiet "
                      "--out /proc/vmh_no_such_dir", kEnv);
