@@ -449,6 +449,24 @@ const std::vector<ParamSpec>& case_fields() {
               })
           .non_negative()
           .source("van Beek et al. (2015), one trial (docs/sources.md, 10); a pen grip: 3.2, 4.6, 9.9 N s/m along x, y, z, about 2.5-16 (Fu & Cavusoglu 2012); 12.6-15.8 along a pen-held stylus (Israr, Choi & Tan 2006) (docs/sources.md, 10.1)"),
+      numeric("hand", "hand_k_pos_axes_N_per_m", 3, "0 0 0", "N/m",
+              "hand translational stiffness along the device frame's x "
+              "(left-right), y (up-down) and z (fore-aft), in place of "
+              "hand_k_pos_N_per_m; 0 0 0: hand_k_pos_N_per_m on every axis",
+              [](CaseParams* p, const ParamValue& v) {
+                p->hand.k_pos_axes_N_per_m = vec3(v);
+              })
+          .non_negative()
+          .source("a stylus in a pen grip reduced to one stage: 65 88 201 N/m (Fu & Cavusoglu 2012, at second hand; docs/sources.md, 10.1)"),
+      numeric("hand", "hand_b_pos_axes_Ns_per_m", 3, "0 0 0", "N s/m",
+              "hand translational damping along the device frame's x, y and "
+              "z, in place of hand_b_pos_Ns_per_m; 0 0 0: "
+              "hand_b_pos_Ns_per_m on every axis",
+              [](CaseParams* p, const ParamValue& v) {
+                p->hand.b_pos_axes_Ns_per_m = vec3(v);
+              })
+          .non_negative()
+          .source("a pen grip reduced to one stage: 3.2 4.6 9.9 N s/m (Fu & Cavusoglu 2012, at second hand; docs/sources.md, 10.1)"),
       numeric("hand", "hand_k_rot_Nm_per_rad", 1, "0.5", "N m/rad",
               "hand rotational stiffness (estimate, models/hand/README.md)",
               [](CaseParams* p, const ParamValue& v) {

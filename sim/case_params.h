@@ -98,6 +98,10 @@ struct HandSettings {
   Vec3 inertia_kgm2 = Vec3::Zero();
   double k_pos_N_per_m{};
   double b_pos_Ns_per_m{};
+  // per device-frame axis (x left-right, y up-down, z fore-aft) in place of
+  // the two above; zero: the scalar on every axis
+  Vec3 k_pos_axes_N_per_m = Vec3::Zero();
+  Vec3 b_pos_axes_Ns_per_m = Vec3::Zero();
   double k_rot_Nm_per_rad{};
   double b_rot_Nms_per_rad{};
 };

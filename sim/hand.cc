@@ -6,6 +6,7 @@
 #include <cstring>
 #include <mutex>
 
+#include "controller/device_frame.h"
 #include "sim/mujoco_util.h"
 
 namespace vmh::sim {
@@ -96,6 +97,8 @@ HandParams hand_params(const CaseParams& c) {
   h.inertia_kgm2 = c.hand.inertia_kgm2;
   h.k_pos_N_per_m = c.hand.k_pos_N_per_m;
   h.b_pos_Ns_per_m = c.hand.b_pos_Ns_per_m;
+  h.k_pos_axes_N_per_m = c.hand.k_pos_axes_N_per_m;
+  h.b_pos_axes_Ns_per_m = c.hand.b_pos_axes_Ns_per_m;
   h.k_rot_Nm_per_rad = c.hand.k_rot_Nm_per_rad;
   h.b_rot_Nms_per_rad = c.hand.b_rot_Nms_per_rad;
   return h;
@@ -104,6 +107,13 @@ HandParams hand_params(const CaseParams& c) {
 SimHand::SimHand(mjModel* m, mjData* d, const HandParams& params,
                  const std::string& source)
     : params_(params) {
+  // diag(k) along the device axes, seen from the world (DH base) frame:
+  // R_db diag(k) R_bd
+  const Mat3 R_bd = R_device_base();
+  k_axes_ = !params_.k_pos_axes_N_per_m.isZero(0.0);
+  b_axes_ = !params_.b_pos_axes_Ns_per_m.isZero(0.0);
+  K_world_ = R_bd.transpose() * params_.k_pos_axes_N_per_m.asDiagonal() * R_bd;
+  B_world_ = R_bd.transpose() * params_.b_pos_axes_Ns_per_m.asDiagonal() * R_bd;
   grip_site_ = require_id(m, mjOBJ_SITE, "grip", source);
   grip_body_ = m->site_bodyid[grip_site_];
   const int target_body = require_id(m, mjOBJ_BODY, "hand_target", source);
@@ -185,8 +195,10 @@ void SimHand::apply(const mjModel* m, mjData* d) {
 
   const Eigen::AngleAxisd dR(target_.R * R.transpose());
   const Vec3 rotvec = dR.angle() * dR.axis();
-  force_N_ = params_.k_pos_N_per_m * (target_.p_m - p) +
-             params_.b_pos_Ns_per_m * (target_.v_m_s - v);
+  const Vec3 dp = target_.p_m - p;
+  const Vec3 dv = target_.v_m_s - v;
+  force_N_ = (k_axes_ ? Vec3(K_world_ * dp) : Vec3(params_.k_pos_N_per_m * dp)) +
+             (b_axes_ ? Vec3(B_world_ * dv) : Vec3(params_.b_pos_Ns_per_m * dv));
   torque_Nm_ = params_.k_rot_Nm_per_rad * rotvec +
                params_.b_rot_Nms_per_rad * (target_.w_rad_s - w);
   if (chain_count_ < 0) {

@@ -38,6 +38,11 @@ struct HandParams {
   Vec3 inertia_kgm2 = Vec3::Constant(2e-4);  // about the grip, grip-site axes
   double k_pos_N_per_m = 135.0;
   double b_pos_Ns_per_m = 6.45;
+  // an anisotropic hand: stiffness and damping along the device frame's x,
+  // y, z (docs/frames: x right, y up, z toward the user) instead of the
+  // scalars; zero: the scalar on every axis
+  Vec3 k_pos_axes_N_per_m = Vec3::Zero();
+  Vec3 b_pos_axes_Ns_per_m = Vec3::Zero();
   double k_rot_Nm_per_rad = 0.5;
   double b_rot_Nms_per_rad = 0.02;
 };
@@ -91,6 +96,10 @@ class SimHand {
 
  private:
   HandParams params_;
+  // the per-axis stiffness and damping as world (DH base) frame matrices,
+  // when given
+  bool k_axes_ = false, b_axes_ = false;
+  Mat3 K_world_ = Mat3::Zero(), B_world_ = Mat3::Zero();
   const mjData* data_ = nullptr;
   int grip_site_ = -1;
   int grip_body_ = -1;

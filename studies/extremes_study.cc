@@ -376,7 +376,10 @@ void judge(const ClosedLoop& loop, bool in_window, ExtremeResult* r) {
   const double T_max_s = loop.substeps_max() * loop.model()->opt.timestep;
   r->colgate_demand_Ns_per_m = 1000.0 * c.controller.k_pos_N_per_mm * T_max_s / 2.0 +
                               1000.0 * std::abs(c.controller.k_vel_Ns_per_mm);
-  r->colgate_b_Ns_per_m = c.hand.b_pos_Ns_per_m;
+  // an anisotropic hand: its least damped axis
+  r->colgate_b_Ns_per_m = c.hand.b_pos_axes_Ns_per_m.isZero(0.0)
+                              ? c.hand.b_pos_Ns_per_m
+                              : c.hand.b_pos_axes_Ns_per_m.minCoeff();
   r->colgate_passive = r->colgate_b_Ns_per_m > r->colgate_demand_Ns_per_m;
   r->energy_expected = r->scenario.energy;
   if (r->energy_expected == "bounded" && !r->colgate_passive) r->energy_expected = "either";

@@ -77,7 +77,7 @@ TEST(RunCli, WritesTraceAndSummary) {
   EXPECT_EQ(s.at("parameters").at("hand_k_pos_N_per_m").at("source"), "scene");
   // the hand's values, together, each with where its default comes from
   const auto& hand = s.at("parameters").at("hand");
-  EXPECT_EQ(hand.size(), 6u);
+  EXPECT_EQ(hand.size(), 8u);  // six scalars, and the per-axis stiffness and damping
   for (const auto& [name, v] : hand.items()) {
     EXPECT_EQ(name.rfind("hand_", 0), 0u) << name;
     ASSERT_TRUE(v.contains("reference")) << name;

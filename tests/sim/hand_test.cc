@@ -157,6 +157,55 @@ TEST_F(HandTest, SpringForceIsStiffnessTimesDisplacement) {
   EXPECT_LT(hand.torque_Nm().norm(), 1e-9);
 }
 
+// A pen grip's hand is stiffer fore-aft than sideways: per-axis stiffness
+// along the device frame. The world is the DH base frame, whose x, y, z are
+// the device's z (toward the user), x (right) and y (up) (docs/kinematics.md), so
+// a target 10 mm off along base x is 10 mm along device z: F = k_z dx
+// there, and likewise for the other two, each alone on its axis.
+TEST_F(HandTest, PerAxisStiffnessActsAlongTheDeviceAxes) {
+  HandParams p;
+  p.k_pos_axes_N_per_m = Vec3(65.0, 88.0, 201.0);  // device x, y, z
+  SimHand hand(model_.get(), data_.get(), p, case1());
+  pose(q_);
+  struct Push {
+    Vec3 d_base_m;
+    Vec3 expected_base_N;
+  };
+  for (const Push& push : {Push{Vec3(0.010, 0, 0), Vec3(2.01, 0, 0)},    // device z
+                           Push{Vec3(0, 0.010, 0), Vec3(0, 0.65, 0)},    // device x
+                           Push{Vec3(0, 0, -0.010), Vec3(0, 0, -0.88)},  // device y
+                           Push{Vec3(0.010, 0.010, 0.010),
+                                Vec3(2.01, 0.65, 0.88)}}) {
+    HandTargetState target;
+    target.p_m = grip_p_m() + push.d_base_m;
+    target.R = grip_R();
+    hand.set_target(model_.get(), data_.get(), target);
+    hand.apply(model_.get(), data_.get());
+    EXPECT_TRUE(hand.force_N().isApprox(push.expected_base_N, 1e-9))
+        << hand.force_N().transpose() << " vs "
+        << push.expected_base_N.transpose();
+  }
+}
+
+// The same for damping; and a hand without per-axis values (0 0 0) keeps
+// its scalar on every axis.
+TEST_F(HandTest, PerAxisDampingActsAlongTheDeviceAxesAndZeroMeansTheScalar) {
+  HandParams p;
+  p.b_pos_axes_Ns_per_m = Vec3(3.2, 4.6, 9.9);  // device x, y, z
+  SimHand hand(model_.get(), data_.get(), p, case1());
+  pose(q_);  // at rest
+  HandTargetState target;
+  target.p_m = grip_p_m() + Vec3(0.010, 0.0, 0.0);
+  target.R = grip_R();
+  target.v_m_s = Vec3(0.1, -0.2, 0.3);  // base x, y, z: device z, x, y
+  hand.set_target(model_.get(), data_.get(), target);
+  hand.apply(model_.get(), data_.get());
+  // stiffness still the scalar 135 N/m (its axes are 0 0 0)
+  const Vec3 expected(1.35 + 9.9 * 0.1, 3.2 * -0.2, 4.6 * 0.3);
+  EXPECT_TRUE(hand.force_N().isApprox(expected, 1e-9))
+      << hand.force_N().transpose() << " vs " << expected.transpose();
+}
+
 // Target turned 0.3 rad about world x from the grip, same place: tau =
 // 0.5 N m/rad x 0.3 rad about x; and 0.2 rad about (0, 0.6, 0.8).
 TEST_F(HandTest, SpringTorqueIsStiffnessTimesAngle) {
@@ -260,8 +309,12 @@ TEST_F(HandTest, HandParamsComeFromTheCase) {
       model_.get(), case1(),
       {"hand_mass_kg=0.3", "hand_inertia_kgm2=1e-4,2e-4,3e-4",
        "hand_k_pos_N_per_m=200", "hand_b_pos_Ns_per_m=4",
-       "hand_k_rot_Nm_per_rad=0.7", "hand_b_rot_Nms_per_rad=0.01"});
+       "hand_k_rot_Nm_per_rad=0.7", "hand_b_rot_Nms_per_rad=0.01",
+       "hand_k_pos_axes_N_per_m=65,88,201",
+       "hand_b_pos_axes_Ns_per_m=3.2,4.6,9.9"});
   const HandParams h = hand_params(c);
+  EXPECT_EQ(h.k_pos_axes_N_per_m, Vec3(65.0, 88.0, 201.0));
+  EXPECT_EQ(h.b_pos_axes_Ns_per_m, Vec3(3.2, 4.6, 9.9));
   EXPECT_EQ(h.mass_kg, 0.3);
   EXPECT_EQ(h.inertia_kgm2, Vec3(1e-4, 2e-4, 3e-4));
   EXPECT_EQ(h.k_pos_N_per_m, 200.0);
