@@ -235,10 +235,13 @@ std::string format_capture_header(const CaptureHeader& h) {
 
 std::string format_capture_record(double t_s, std::uint8_t endpoint,
                                   const std::uint8_t* data, std::size_t size) {
-  char head[64];
-  std::snprintf(head, sizeof head, "%.6f 0x%02x %zu", t_s,
+  // sized by snprintf itself: %.6f of a large t_s is hundreds of digits, and a
+  // fixed buffer cut the endpoint and length off the line
+  const int head = std::snprintf(nullptr, 0, "%.6f 0x%02x %zu", t_s,
+                                 static_cast<unsigned>(endpoint), size);
+  std::string s(static_cast<std::size_t>(head), '\0');
+  std::snprintf(s.data(), s.size() + 1, "%.6f 0x%02x %zu", t_s,
                 static_cast<unsigned>(endpoint), size);
-  std::string s = head;
   if (size > 0) {
     s += ' ';
     static const char* const kHex = "0123456789abcdef";

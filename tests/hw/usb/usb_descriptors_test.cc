@@ -206,3 +206,18 @@ TEST(UdevRules, EveryTouchIdHasAUsbRule) {
 }
 
 }  // namespace
+
+// usb_codec_fuzz's first finding: a large t_s (%.6f prints every digit) was
+// written into a 64-byte buffer, which cut the endpoint and the length off,
+// and the line did not read back
+TEST(CaptureFormat, ALargeTimeIsWrittenWhole) {
+  const std::uint8_t bytes[] = {0xff};
+  const std::string line = format_capture_record(1e300, 0x81, bytes, 1);
+  ASSERT_GT(line.size(), 300u);
+  EXPECT_EQ(line.compare(line.size() - 18, 18, ".000000 0x81 1 ff\n"), 0);
+  const auto r = parse_capture_record(line.substr(0, line.size() - 1));
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->t_s, 1e300);
+  EXPECT_EQ(r->endpoint, 0x81);
+  EXPECT_EQ(r->data, std::vector<std::uint8_t>(bytes, bytes + 1));
+}
