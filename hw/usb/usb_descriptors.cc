@@ -282,7 +282,10 @@ std::optional<CaptureRecord> parse_capture_record(const std::string& line) {
   bool len_ok = !len.empty();
   for (char c : len) len_ok = len_ok && std::isdigit(static_cast<unsigned char>(c));
   if (len_ok) n = static_cast<std::size_t>(std::strtoull(len.c_str(), nullptr, 10));
-  if (!t_ok || !ep_ok || !len_ok || hex.size() != 2 * n || !extra.empty()) {
+  // n > hex.size() first: a 19-digit length near 2^63 wraps 2 * n round to
+  // the hex's size, and the loop below then read past the hex
+  if (!t_ok || !ep_ok || !len_ok || n > hex.size() || hex.size() != 2 * n ||
+      !extra.empty()) {
     throw std::invalid_argument("not a capture record: '" + line + "'");
   }
   r.endpoint = static_cast<std::uint8_t>(hex_digit(ep[2]) * 16 + hex_digit(ep[3]));

@@ -221,3 +221,15 @@ TEST(CaptureFormat, ALargeTimeIsWrittenWhole) {
   EXPECT_EQ(r->endpoint, 0x81);
   EXPECT_EQ(r->data, std::vector<std::uint8_t>(bytes, bytes + 1));
 }
+
+// a length near 2^63 made 2 × length wrap round to the hex's size, so the
+// line passed the length check and the loop read the hex past its end (the
+// line was still refused, at the terminating NUL, which is why this passed
+// before the fix too: it keeps the check in front of the loop)
+TEST(CaptureFormat, ALengthThatWrapsIsRefused) {
+  EXPECT_THROW(parse_capture_record("0 0x81 9223372036854775816 "
+                                    "00112233445566778899aabbccddeeff"),
+               std::invalid_argument);
+  EXPECT_THROW(parse_capture_record("0 0x81 9223372036854775808"),
+               std::invalid_argument);
+}
