@@ -235,10 +235,13 @@ std::string format_capture_header(const CaptureHeader& h) {
 
 std::string format_capture_record(double t_s, std::uint8_t endpoint,
                                   const std::uint8_t* data, std::size_t size) {
-  char head[64];
-  std::snprintf(head, sizeof head, "%.6f 0x%02x %zu", t_s,
+  // sized by snprintf itself: %.6f of a large t_s is hundreds of digits, and a
+  // fixed buffer cut the endpoint and length off the line
+  const int head = std::snprintf(nullptr, 0, "%.6f 0x%02x %zu", t_s,
+                                 static_cast<unsigned>(endpoint), size);
+  std::string s(static_cast<std::size_t>(head), '\0');
+  std::snprintf(s.data(), s.size() + 1, "%.6f 0x%02x %zu", t_s,
                 static_cast<unsigned>(endpoint), size);
-  std::string s = head;
   if (size > 0) {
     s += ' ';
     static const char* const kHex = "0123456789abcdef";
@@ -279,7 +282,10 @@ std::optional<CaptureRecord> parse_capture_record(const std::string& line) {
   bool len_ok = !len.empty();
   for (char c : len) len_ok = len_ok && std::isdigit(static_cast<unsigned char>(c));
   if (len_ok) n = static_cast<std::size_t>(std::strtoull(len.c_str(), nullptr, 10));
-  if (!t_ok || !ep_ok || !len_ok || hex.size() != 2 * n || !extra.empty()) {
+  // n > hex.size() first: a 19-digit length near 2^63 wraps 2 * n round to
+  // the hex's size, and the loop below then read past the hex
+  if (!t_ok || !ep_ok || !len_ok || n > hex.size() || hex.size() != 2 * n ||
+      !extra.empty()) {
     throw std::invalid_argument("not a capture record: '" + line + "'");
   }
   r.endpoint = static_cast<std::uint8_t>(hex_digit(ep[2]) * 16 + hex_digit(ep[3]));

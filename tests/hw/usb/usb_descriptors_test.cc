@@ -206,3 +206,30 @@ TEST(UdevRules, EveryTouchIdHasAUsbRule) {
 }
 
 }  // namespace
+
+// usb_codec_fuzz's first finding: a large t_s (%.6f prints every digit) was
+// written into a 64-byte buffer, which cut the endpoint and the length off,
+// and the line did not read back
+TEST(CaptureFormat, ALargeTimeIsWrittenWhole) {
+  const std::uint8_t bytes[] = {0xff};
+  const std::string line = format_capture_record(1e300, 0x81, bytes, 1);
+  ASSERT_GT(line.size(), 300u);
+  EXPECT_EQ(line.compare(line.size() - 18, 18, ".000000 0x81 1 ff\n"), 0);
+  const auto r = parse_capture_record(line.substr(0, line.size() - 1));
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->t_s, 1e300);
+  EXPECT_EQ(r->endpoint, 0x81);
+  EXPECT_EQ(r->data, std::vector<std::uint8_t>(bytes, bytes + 1));
+}
+
+// a length near 2^63 made 2 × length wrap round to the hex's size, so the
+// line passed the length check and the loop read the hex past its end (the
+// line was still refused, at the terminating NUL, which is why this passed
+// before the fix too: it keeps the check in front of the loop)
+TEST(CaptureFormat, ALengthThatWrapsIsRefused) {
+  EXPECT_THROW(parse_capture_record("0 0x81 9223372036854775816 "
+                                    "00112233445566778899aabbccddeeff"),
+               std::invalid_argument);
+  EXPECT_THROW(parse_capture_record("0 0x81 9223372036854775808"),
+               std::invalid_argument);
+}
