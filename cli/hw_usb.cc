@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "cli/args.h"
+#include "cli/hw_common.h"
 #include "hw/usb/touch_usb.h"
 
 namespace vmh::cli {
@@ -142,13 +143,7 @@ struct CaptureArgs {
 void capture(const CaptureArgs& a) {
   usb::CaptureOptions o;
   o.where = usb_where(a.device);
-  // the capture's own check refuses <= 0 and non-finite; an hour at most
-  if (a.duration_s > 3600.0) {
-    char buf[80];
-    std::snprintf(buf, sizeof buf, "hw capture: --duration must be <= 3600 s, got %g",
-                  a.duration_s);
-    throw UsageError(buf);
-  }
+  check_seconds("hw capture: --duration", a.duration_s, 0.0, 3600.0);
   o.duration_s = a.duration_s;
   o.out_path = a.out;
   o.detach = a.detach;

@@ -214,7 +214,7 @@ TEST(HwCli, TimesOutOfRangeAreRefusedNamingTheOption) {
       {"hw calibrate --device emulator --sweep-s 1",
        "hw calibrate: --sweep-s must be > 1 and <= 600 s, got 1"},
       {"hw capture --device usb --duration 1e9 --out x.bin",
-       "hw capture: --duration must be <= 3600 s, got 1e+09"},
+       "hw capture: --duration must be > 0 and <= 3600 s, got 1e+09"},
   };
   for (const auto& b : bad) {
     const auto r = run(b.args, kEnv);
