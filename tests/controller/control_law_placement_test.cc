@@ -57,6 +57,18 @@ double optimality(const VirtualMechanism& vm, const RmPose& rm, const Vec6& w,
   return (X(J).transpose() * Wr).norm() / (J.norm() * Wr.norm() + 1e-300);
 }
 
+// a stylus standing above a surface VM's plane, more or less upright, the
+// wrist centre within L of the mount along the plane and 0.3-2 L above it
+RmPose random_pose_above(const SurfaceVm& vm, std::mt19937* rng) {
+  const double L = vm.length();
+  const Vec3 o = vm.mount().origin, n = vm.normal();
+  const Vec3 axis = (n + 0.7 * random_unit(rng)).normalized();
+  const Vec3 p = o + uniform(rng, -L, L) * vm.mount().R.col(0) +
+                 uniform(rng, -L, L) * vm.mount().R.col(1) +
+                 uniform(rng, 0.3, 2.0) * L * n;
+  return RmPose{p, axis};
+}
+
 Vec6 position_weights() { return (Vec6() << 1, 1, 1, 0, 0, 0).finished(); }
 Vec6 orientation_weights() { return (Vec6() << 0, 0, 0, 1, 1, 1).finished(); }
 
@@ -410,12 +422,7 @@ TEST(PlaceGaussNewton, SurfaceIdentityWeightIsOptimalOnThePlane) {
     int not_converged = 0;
     double worst_optimality = 0, worst_gradient = 0;
     for (int k = 0; k < 100; ++k) {
-      // a stylus standing above the plane, more or less upright
-      const Vec3 axis = (n + 0.7 * random_unit(&rng)).normalized();
-      const Vec3 p = o + uniform(&rng, -L, L) * vm.mount().R.col(0) +
-                     uniform(&rng, -L, L) * vm.mount().R.col(1) +
-                     uniform(&rng, 0.3, 2.0) * L * n;
-      const RmPose rm{p, axis};
+      const RmPose rm = random_pose_above(vm, &rng);
       VmAngles aligned = random_theta(vm, &rng);
       ASSERT_TRUE(vm.aligned(rm, &aligned));
       VmAngles theta = aligned;
@@ -450,7 +457,6 @@ TEST(SurfacePlacementMinimum, IsTheOptimumGaussNewtonConfirms) {
   for (const Case& c : cases({VmKind::kSurface})) {
     const auto& vm = static_cast<const SurfaceVm&>(*c.vm);
     const double L = vm.length();
-    const Vec3 o = vm.mount().origin, n = vm.normal();
     for (int held = 0; held < 2; ++held) {
       for (int wk = 0; wk < 2; ++wk) {
         PlacementOptions opt;
@@ -460,11 +466,7 @@ TEST(SurfacePlacementMinimum, IsTheOptimumGaussNewtonConfirms) {
         int found = 0;
         double worst_optimality = 0, worst_gradient = 0;
         for (int k = 0; k < 100; ++k) {
-          const Vec3 axis = (n + 0.7 * random_unit(&rng)).normalized();
-          const Vec3 p = o + uniform(&rng, -L, L) * vm.mount().R.col(0) +
-                         uniform(&rng, -L, L) * vm.mount().R.col(1) +
-                         uniform(&rng, 0.3, 2.0) * L * n;
-          const RmPose rm{p, axis};
+          const RmPose rm = random_pose_above(vm, &rng);
           VmAngles start = random_theta(vm, &rng);
           ASSERT_TRUE(vm.aligned(rm, &start));
           VmAngles theta = start;
