@@ -75,6 +75,65 @@ inline SinCos sin_cos(double x) {
   }
 }
 
+// atan2(y, x) inline, for the VMs' angles (theta_V and theta_R from a
+// direction: four calls per sphere tick, two per circle tick).
+//
+// Why: perf on controller_bench/sphere/closed put glibc's __ieee754_acos and
+// __ieee754_atan2 at 18% of the tick (four calls through the PLT, one after
+// the other); the polar angle now comes from atan2 too (acos(-d_z) =
+// atan2(|d_xy|, -d_z) for a unit d, and better conditioned at the poles).
+//
+// How: fold (y, x) into the first octant, num = min(|x|, |y|) <= den =
+// max(|x|, |y|); above tan(pi/8) take atan(num/den) = pi/4 + atan((num -
+// den)/(num + den)), so one division leaves an argument u with |u| <=
+// tan(pi/8) < 7/16, where fdlibm's s_atan.c polynomial (11 coefficients) is
+// accurate to below one ulp. Then unfold: pi/2 - a where |y| > |x|, pi - a
+// where x < 0, the sign of y. The pi/4 and pi/2 constants carry their
+// low-order parts (fdlibm's atanhi/atanlo). Both arguments zero, or either
+// not finite, go to std::atan2 (signed zeros, infinities, NaN). Checked
+// against std::atan2 in tests/controller/trig_test.cc (within 4.5e-16
+// absolute, two ulps of pi, over random and edge arguments).
+inline double atan2_fast(double y, double x) {
+  constexpr double kAT0 = 3.33333333333329318027e-01;
+  constexpr double kAT1 = -1.99999999998764832476e-01;
+  constexpr double kAT2 = 1.42857142725034663711e-01;
+  constexpr double kAT3 = -1.11111104054623557880e-01;
+  constexpr double kAT4 = 9.09088713343650656196e-02;
+  constexpr double kAT5 = -7.69187620504482999495e-02;
+  constexpr double kAT6 = 6.66107313738753120669e-02;
+  constexpr double kAT7 = -5.83357013379057348645e-02;
+  constexpr double kAT8 = 4.97687799461593236017e-02;
+  constexpr double kAT9 = -3.65315727442169155270e-02;
+  constexpr double kAT10 = 1.62858201153657823623e-02;
+  constexpr double kPio4Hi = 7.85398163397448278999e-01;
+  constexpr double kPio4Lo = 3.06161699786838301793e-17;
+  constexpr double kPio2Hi = 1.57079632679489655800e+00;
+  constexpr double kPio2Lo = 6.12323399573676603587e-17;
+  constexpr double kPiHi = 3.14159265358979311600e+00;
+  constexpr double kPiLo = 1.22464679914735317720e-16;
+  constexpr double kTanPio8 = 0.41421356237309503;
+
+  const double ax = std::abs(x), ay = std::abs(y);
+  // both zero, or a NaN or infinity: libm's conventions
+  if (!(ax + ay > 0.0) || !(ax + ay < HUGE_VAL)) return std::atan2(y, x);
+  const bool steep = ay > ax;
+  const double num = steep ? ax : ay;
+  const double den = steep ? ay : ax;
+  const bool upper = num > kTanPio8 * den;
+  const double u = upper ? (num - den) / (num + den) : num / den;
+  const double z = u * u;
+  const double w = z * z;
+  const double s1 =
+      z * (kAT0 + w * (kAT2 + w * (kAT4 + w * (kAT6 + w * (kAT8 + w * kAT10)))));
+  const double s2 = w * (kAT1 + w * (kAT3 + w * (kAT5 + w * (kAT7 + w * kAT9))));
+  // atan(num / den) in [0, pi/4], with pi/4's low part where it was added
+  double a = upper ? kPio4Hi - ((u * (s1 + s2) - kPio4Lo) - u)
+                   : u - u * (s1 + s2);
+  if (steep) a = (kPio2Hi - a) + kPio2Lo;
+  if (x < 0.0) a = (kPiHi - a) + kPiLo;
+  return std::signbit(y) ? -a : a;
+}
+
 }  // namespace vmh
 
 #endif  // VMHAPTICS_CONTROLLER_TRIG_H_

@@ -261,7 +261,7 @@ bool CircleVm::nearest(const RmPose& rm, VmAngles* theta) const {
   // §3.3.1: theta_V = atan2(Y - Y0, X - X0), in the pivot frame
   const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
   if (!above(d.x(), d.y(), kDegenerateFraction * length_)) return false;
-  (*theta)[0] = std::atan2(d.y(), d.x());
+  (*theta)[0] = atan2_fast(d.y(), d.x());
   return true;
 }
 
@@ -269,7 +269,7 @@ bool CircleVm::aligned(const RmPose& rm, VmAngles* theta) const {
   // §3.3.1: theta_R = atan2(Z_y, Z_x) of the stylus z axis
   const Vec3 a = mount_.R.transpose() * rm.axis;
   if (!above(a.x(), a.y(), kPoleSin)) return false;
-  (*theta)[0] = std::atan2(a.y(), a.x());
+  (*theta)[0] = atan2_fast(a.y(), a.x());
   return true;
 }
 
@@ -289,7 +289,7 @@ Vec3 CircleVm::geometric_orientation_error(const VmPose& vm, const RmPose& rm,
     if (ambiguous != nullptr) *ambiguous = true;
     return Vec3::Zero();
   }
-  return n * std::atan2(n.dot(a.cross(vm.axis)), a.dot(vm.axis));
+  return n * atan2_fast(n.dot(a.cross(vm.axis)), a.dot(vm.axis));
 }
 
 Mat3 CircleVm::orientation_error_jacobian(const VmPose&,
@@ -375,30 +375,35 @@ void SphereVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
 }
 
 namespace {
-// polar angle from -z and azimuth of a unit direction d (pivot frame):
-// theta2 = pi - acos(d_z) = acos(-d_z) (§3.4.1), theta1 = atan2(d_y, d_x);
-// on the pole axis theta1 is left as it was
+// polar angle from -z and azimuth of a direction d (pivot frame, any
+// length > 0): theta2 = pi - acos(d_z/|d|) = atan2(|d_xy|, -d_z) (§3.4.1),
+// theta1 = atan2(d_y, d_x); on the pole axis theta1 is left as it was. Both
+// atan2s are scale-free, so d needs no normalising; atan2 also keeps its
+// accuracy near the poles, where acos loses half its digits
 void sphere_angles(const Vec3& d, VmAngles* theta) {
-  (*theta)[1] = std::acos(clamp_unit(-d.z()));
-  if (above(d.x(), d.y(), kPoleSin)) {
-    (*theta)[0] = std::atan2(d.y(), d.x());
+  const double rho2 = d.x() * d.x() + d.y() * d.y();
+  (*theta)[1] = atan2_fast(std::sqrt(rho2), -d.z());
+  if (rho2 > kPoleSin * kPoleSin * d.squaredNorm()) {
+    (*theta)[0] = atan2_fast(d.y(), d.x());
   }
 }
 }  // namespace
 
 bool SphereVm::nearest(const RmPose& rm, VmAngles* theta) const {
   const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
-  const double LL = d.norm();  // §3.4.1's LL
-  if (!(LL > kDegenerateFraction * length_)) return false;
-  sphere_angles(d / LL, theta);
+  // §3.4.1's LL = |d|, compared squared
+  if (!(d.squaredNorm() > kDegenerateFraction * kDegenerateFraction *
+                              length_ * length_)) {
+    return false;
+  }
+  sphere_angles(d, theta);
   return true;
 }
 
 bool SphereVm::aligned(const RmPose& rm, VmAngles* theta) const {
   const Vec3 a = mount_.R.transpose() * rm.axis;
-  const double n = a.norm();
-  if (!(n > kPoleSin)) return false;
-  sphere_angles(a / n, theta);
+  if (!(a.squaredNorm() > kPoleSin * kPoleSin)) return false;
+  sphere_angles(a, theta);
   return true;
 }
 
