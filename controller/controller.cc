@@ -197,17 +197,28 @@ void Controller::reset() noexcept {
 }
 
 ControlStatus Controller::place(const RmPose& rm, JointMask locked,
-                                ControlOutput* out) noexcept {
+                                ControlOutput* out, VmPose* pose,
+                                bool* posed) noexcept {
   ControlStatus st = kStatusOk;
+  *posed = false;
   const bool contact_sliding = vm_->has_contact() && locked == 0u;
+  const bool closed_form = params_.placement == PlacementMethod::kClosedForm;
   // the closed form: nearest point (circle, sphere, sticking surface); for
-  // a sliding surface the probe aligned with the stylus, tip on the plane
+  // a sliding surface the probe aligned with the stylus, tip on the plane.
+  // Where it is the placement, its pose and J_V come with it
   seed_ = theta_v_;
-  const bool seed_ok = contact_sliding ? vm_->aligned(rm, &seed_)
-                                       : vm_->nearest(rm, &seed_);
+  bool seed_ok;
+  if (contact_sliding) {
+    seed_ok = vm_->aligned(rm, &seed_);
+  } else if (closed_form) {
+    seed_ok = vm_->nearest_pose_jacobian(rm, &seed_, pose, &J_);
+    *posed = seed_ok;
+  } else {
+    seed_ok = vm_->nearest(rm, &seed_);
+  }
   if (!seed_ok) st |= kStatusRmAtPivot;
   if (!placed_ && seed_ok) theta_v_ = seed_;
-  if (params_.placement == PlacementMethod::kClosedForm) {
+  if (closed_form) {
     if (seed_ok) theta_v_ = seed_;
     out->placement_iterations = 0;
     // r^T W r at theta_V: evaluate() computes it from the pose it needs
@@ -266,15 +277,15 @@ ControlStatus Controller::place(const RmPose& rm, JointMask locked,
 
 ControlStatus Controller::evaluate(const RmPose& rm, JointMask locked,
                                    ControlOutput* out) noexcept {
-  ControlStatus st = place(rm, locked, out);
-  const double u = params_.length_unit_mm;
   VmPose vm_pose;
-  vm_->pose_jacobian(theta_v_, &vm_pose, &J_);
+  bool posed = false;
+  ControlStatus st = place(rm, locked, out, &vm_pose, &posed);
+  const double u = params_.length_unit_mm;
+  if (!posed) vm_->pose_jacobian(theta_v_, &vm_pose, &J_);
   if (params_.placement == PlacementMethod::kClosedForm) {
     out->placement_cost = closed_form_cost(vm_pose, rm);
   }
   out->x_v_mm = vm_pose.p * u;
-  out->x_r_mm = vm_->position(theta_r_) * u;
   // eq. 3.9: e = X_V - X_R
   out->e.head<3>() = vm_pose.p - rm.p;
   if (params_.error == ErrorFormulation::kThesis) {
@@ -440,8 +451,13 @@ ControlStatus Controller::tick(const Joints& q_dh, ControlOutput* out) noexcept 
   // arm's Jacobian for step 5, in one pass over the chain
   const OmniArmKinematics arm = omni_arm_kinematics(params_.omni, q_dh);
   const RmPose rm = rm_pose(arm, out);
-  // 2. theta_R: the VM aligned with the stylus (kept where undefined)
-  if (!vm_->aligned(rm, &theta_r_)) st |= kStatusOrientationDegenerate;
+  // 2. theta_R: the VM aligned with the stylus (kept where undefined), and
+  // X(theta_R)'s position for the output
+  Vec3 x_r;
+  if (!vm_->aligned_position(rm, &theta_r_, &x_r)) {
+    st |= kStatusOrientationDegenerate;
+  }
+  out->x_r_mm = x_r * params_.length_unit_mm;
   // 3-4. placement, error and projected force
   st |= evaluate_with_contact(rm, out);
   placed_ = true;

@@ -185,9 +185,10 @@ class Controller {
 
  private:
   // theta_V from the warm start (or the closed form); fills the placement
-  // diagnostics of *out
-  ControlStatus place(const RmPose& rm, JointMask locked,
-                      ControlOutput* out) noexcept;
+  // diagnostics of *out. *posed says whether *pose and J_ already hold
+  // X_V and J_V at theta_V (the closed form gives them with the angles)
+  ControlStatus place(const RmPose& rm, JointMask locked, ControlOutput* out,
+                      VmPose* pose, bool* posed) noexcept;
   // place, then e, e_dot and f_motion into *out
   ControlStatus evaluate(const RmPose& rm, JointMask locked,
                          ControlOutput* out) noexcept;

@@ -44,8 +44,9 @@ void push_unique(const OmniParams& params, const Joints& q, IkSolutions* out) {
 
 }  // namespace
 
-double wrap_angle(double a) {
-  // the common case costs two comparisons; NaN fails them and passes through
+double wrap_angle_out_of_range(double a) {
+  // wrap_angle (inline) has returned an angle already in range; NaN fails
+  // its comparisons and passes through below
   if (a > -kPi && a <= kPi) return a;
   // one turn off (a difference of two wrapped angles): subtracting 2 pi is
   // exact there (Sterbenz) and is what remainder() returns, without its call

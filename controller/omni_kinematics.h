@@ -150,7 +150,14 @@ int omni_wrist_angles(const OmniParams& params, const Eigen::Vector3d& q123,
                       std::array<Eigen::Vector3d, 2>* q456, bool* singular);
 
 // Wraps an angle to (-pi, pi]. Non-finite input is returned unchanged.
-double wrap_angle(double a_rad);
+// The common case, an angle already in range (two comparisons), is inline:
+// the servo tick wraps five angles; the rest is out of line.
+double wrap_angle_out_of_range(double a_rad);
+inline double wrap_angle(double a_rad) {
+  constexpr double kPi = 3.14159265358979323846;
+  if (a_rad > -kPi && a_rad <= kPi) return a_rad;
+  return wrap_angle_out_of_range(a_rad);
+}
 
 // Whether every joint angle, wrapped to (-pi, pi], lies inside the joint
 // ranges of `params` (DH convention). False for non-finite angles.

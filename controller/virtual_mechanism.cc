@@ -257,11 +257,21 @@ void CircleVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
   circle_jacobian(mount_, length_, c, s, J);
 }
 
+namespace {
+// theta = atan2(y, x) (§3.3.1) for (x, y) off the origin; returns its sine
+// and cosine from (x, y) itself, which callers needing only the angle drop
+SinCos circle_angle(double x, double y, VmAngles* theta) {
+  (*theta)[0] = atan2_fast(y, x);
+  const double inv = 1.0 / std::sqrt(x * x + y * y);
+  return SinCos{y * inv, x * inv};
+}
+}  // namespace
+
 bool CircleVm::nearest(const RmPose& rm, VmAngles* theta) const {
   // §3.3.1: theta_V = atan2(Y - Y0, X - X0), in the pivot frame
   const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
   if (!above(d.x(), d.y(), kDegenerateFraction * length_)) return false;
-  (*theta)[0] = atan2_fast(d.y(), d.x());
+  circle_angle(d.x(), d.y(), theta);
   return true;
 }
 
@@ -269,7 +279,29 @@ bool CircleVm::aligned(const RmPose& rm, VmAngles* theta) const {
   // §3.3.1: theta_R = atan2(Z_y, Z_x) of the stylus z axis
   const Vec3 a = mount_.R.transpose() * rm.axis;
   if (!above(a.x(), a.y(), kPoleSin)) return false;
-  (*theta)[0] = atan2_fast(a.y(), a.x());
+  circle_angle(a.x(), a.y(), theta);
+  return true;
+}
+
+bool CircleVm::nearest_pose_jacobian(const RmPose& rm, VmAngles* theta,
+                                     VmPose* pose, VmJacobian* J) const {
+  const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
+  if (!above(d.x(), d.y(), kDegenerateFraction * length_)) return false;
+  const SinCos t = circle_angle(d.x(), d.y(), theta);
+  *pose = circle_pose(mount_, length_, t.c, t.s);
+  circle_jacobian(mount_, length_, t.c, t.s, J);
+  return true;
+}
+
+bool CircleVm::aligned_position(const RmPose& rm, VmAngles* theta,
+                                Vec3* p) const {
+  const Vec3 a = mount_.R.transpose() * rm.axis;
+  if (!above(a.x(), a.y(), kPoleSin)) {
+    *p = position(*theta);
+    return false;
+  }
+  const SinCos t = circle_angle(a.x(), a.y(), theta);
+  *p = mount_.origin + length_ * (mount_.R * Vec3(t.c, t.s, 0.0));
   return true;
 }
 
@@ -375,17 +407,27 @@ void SphereVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
 }
 
 namespace {
-// polar angle from -z and azimuth of a direction d (pivot frame, any
-// length > 0): theta2 = pi - acos(d_z/|d|) = atan2(|d_xy|, -d_z) (§3.4.1),
-// theta1 = atan2(d_y, d_x); on the pole axis theta1 is left as it was. Both
-// atan2s are scale-free, so d needs no normalising; atan2 also keeps its
-// accuracy near the poles, where acos loses half its digits
-void sphere_angles(const Vec3& d, VmAngles* theta) {
+// Polar angle from -z and azimuth of a direction d (pivot frame, any length
+// > 0): theta2 = pi - acos(d_z/|d|) = atan2(|d_xy|, -d_z) (§3.4.1), theta1 =
+// atan2(d_y, d_x); on the pole axis theta1 is left as it was. Both atan2s
+// are scale-free, so d needs no normalising, and atan2 keeps its accuracy
+// near the poles, where acos loses half its digits. Returns the sines and
+// cosines of the angles set, from d itself: s2 = |d_xy|/|d|, c2 = -d_z/|d|,
+// (c1, s1) = d_xy/|d_xy| (theta1's own on the pole); callers that need only
+// the angles drop them (inline: the compiler drops their arithmetic too).
+SphereTrig sphere_angles(const Vec3& d, VmAngles* theta) {
   const double rho2 = d.x() * d.x() + d.y() * d.y();
-  (*theta)[1] = atan2_fast(std::sqrt(rho2), -d.z());
-  if (rho2 > kPoleSin * kPoleSin * d.squaredNorm()) {
+  const double n2 = rho2 + d.z() * d.z();
+  const double rho = std::sqrt(rho2);
+  (*theta)[1] = atan2_fast(rho, -d.z());
+  const double inv_n = 1.0 / std::sqrt(n2);
+  const SinCos t2{rho * inv_n, -d.z() * inv_n};
+  if (rho2 > kPoleSin * kPoleSin * n2) {
     (*theta)[0] = atan2_fast(d.y(), d.x());
+    const double inv_rho = 1.0 / rho;
+    return SphereTrig(SinCos{d.y() * inv_rho, d.x() * inv_rho}, t2);
   }
+  return SphereTrig(sin_cos((*theta)[0]), t2);
 }
 }  // namespace
 
@@ -404,6 +446,33 @@ bool SphereVm::aligned(const RmPose& rm, VmAngles* theta) const {
   const Vec3 a = mount_.R.transpose() * rm.axis;
   if (!(a.squaredNorm() > kPoleSin * kPoleSin)) return false;
   sphere_angles(a, theta);
+  return true;
+}
+
+
+bool SphereVm::nearest_pose_jacobian(const RmPose& rm, VmAngles* theta,
+                                     VmPose* pose, VmJacobian* J) const {
+  const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
+  if (!(d.squaredNorm() > kDegenerateFraction * kDegenerateFraction *
+                              length_ * length_)) {
+    return false;
+  }
+  const SphereTrig t = sphere_angles(d, theta);
+  *pose = sphere_pose(mount_, length_, t, (*theta)[2]);
+  sphere_jacobian(mount_, length_, t, J);
+  return true;
+}
+
+bool SphereVm::aligned_position(const RmPose& rm, VmAngles* theta,
+                                Vec3* p) const {
+  const Vec3 a = mount_.R.transpose() * rm.axis;
+  if (!(a.squaredNorm() > kPoleSin * kPoleSin)) {
+    *p = position(*theta);
+    return false;
+  }
+  const SphereTrig t = sphere_angles(a, theta);
+  *p = mount_.origin +
+       length_ * (mount_.R * Vec3(t.c1 * t.s2, t.s1 * t.s2, -t.c2));
   return true;
 }
 

@@ -126,6 +126,27 @@ class VirtualMechanism {
   virtual bool nearest(const RmPose& rm, VmAngles* theta) const = 0;
   virtual bool aligned(const RmPose& rm, VmAngles* theta) const = 0;
 
+  // What a closed-form servo tick asks for, each in one call: nearest() and,
+  // where it succeeds, pose_jacobian() at the angles it set; aligned() and
+  // then the handle's position at *theta (changed or kept). A VM whose
+  // closed form yields the pose's sines and cosines from the direction it
+  // measured (the circle, the sphere) overrides them and skips the round
+  // trip through the angles (atan2, then sin and cos: one on the other's
+  // result, on the tick's critical path). The same numbers as the calls
+  // they combine, to rounding.
+  virtual bool nearest_pose_jacobian(const RmPose& rm, VmAngles* theta,
+                                     VmPose* pose, VmJacobian* J) const {
+    if (!nearest(rm, theta)) return false;
+    pose_jacobian(*theta, pose, J);
+    return true;
+  }
+  virtual bool aligned_position(const RmPose& rm, VmAngles* theta,
+                                Vec3* p) const {
+    const bool ok = aligned(rm, theta);
+    *p = position(*theta);
+    return ok;
+  }
+
   // The thesis's orientation error rows (theta_x, theta_y, theta_z) from
   // joint-angle differences, each wrapped to (-pi, pi] (eq. 3.32-3.37 and
   // §3.3.1). The surface has no thesis formula; it maps the wrapped revolute
@@ -214,6 +235,10 @@ class CircleVm final : public VirtualMechanism {
   Vec3 position(const VmAngles& theta) const override;
   bool nearest(const RmPose& rm, VmAngles* theta) const override;
   bool aligned(const RmPose& rm, VmAngles* theta) const override;
+  bool nearest_pose_jacobian(const RmPose& rm, VmAngles* theta, VmPose* pose,
+                             VmJacobian* J) const override;
+  bool aligned_position(const RmPose& rm, VmAngles* theta,
+                        Vec3* p) const override;
   Vec3 thesis_orientation_error(const VmAngles& theta_v,
                                 const VmAngles& theta_r) const override;
   Vec3 geometric_orientation_error(const VmPose& vm, const RmPose& rm,
@@ -238,6 +263,10 @@ class SphereVm final : public VirtualMechanism {
   Vec3 position(const VmAngles& theta) const override;
   bool nearest(const RmPose& rm, VmAngles* theta) const override;
   bool aligned(const RmPose& rm, VmAngles* theta) const override;
+  bool nearest_pose_jacobian(const RmPose& rm, VmAngles* theta, VmPose* pose,
+                             VmJacobian* J) const override;
+  bool aligned_position(const RmPose& rm, VmAngles* theta,
+                        Vec3* p) const override;
   Vec3 thesis_orientation_error(const VmAngles& theta_v,
                                 const VmAngles& theta_r) const override;
   bool is_revolute(int) const override { return true; }

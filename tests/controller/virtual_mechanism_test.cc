@@ -433,6 +433,60 @@ TEST(VmNearest, SpherePolesAreFinite) {
   }
 }
 
+// the closed-form tick's combined calls (nearest_pose_jacobian,
+// aligned_position) against the calls they combine: the circle and the
+// sphere take the pose's sines and cosines from the measured direction
+// instead of from the angles, so the two routes differ only by rounding;
+// the angles and the verdicts are the same. Random RMs, on-pole RMs and RMs
+// at the pivot (where both return false and keep theta).
+TEST(VmNearest, CombinedCallsMatchTheCallsTheyCombine) {
+  std::mt19937 rng(180);
+  for (const Case& c : all_cases()) {
+    const VirtualMechanism& vm = *c.vm;
+    const double L = vm.length();
+    const Vec3 o = vm.mount().origin, z = vm.mount().R.col(2);
+    for (int k = 0; k < 600; ++k) {
+      const VmAngles start = random_theta(vm, &rng);
+      RmPose rm;
+      rm.axis = random_unit(&rng);
+      rm.p = o + uniform(&rng, 0.1, 3.0) * L * random_unit(&rng);
+      if (k % 100 == 1) rm.p = o + 2.0 * L * z;  // the sphere's pole
+      if (k % 100 == 2) rm.axis = z;             // stylus on the pole axis
+      if (k % 100 == 3) rm.p = link_base(vm, start);  // at the pivot
+      if (k % 100 == 4) rm.axis = Vec3::Zero();
+      VmAngles parts = start, combined = start;
+      VmPose pose_parts, pose_combined;
+      VmJacobian J_parts, J_combined;
+      const bool ok_parts = vm.nearest(rm, &parts);
+      const bool ok_combined =
+          vm.nearest_pose_jacobian(rm, &combined, &pose_combined, &J_combined);
+      ASSERT_EQ(ok_parts, ok_combined) << c.name << " k = " << k;
+      EXPECT_TRUE(parts == combined) << c.name << " k = " << k;
+      if (ok_parts) {
+        vm.pose_jacobian(parts, &pose_parts, &J_parts);
+        EXPECT_LE((pose_combined.p - pose_parts.p).norm(), 1e-12 * (1 + L))
+            << c.name << " k = " << k;
+        EXPECT_LE((pose_combined.R - pose_parts.R).norm(), 1e-12)
+            << c.name << " k = " << k;
+        EXPECT_LE((pose_combined.axis - pose_parts.axis).norm(), 1e-12)
+            << c.name << " k = " << k;
+        ASSERT_EQ(J_combined.cols(), J_parts.cols()) << c.name;
+        EXPECT_LE((J_combined - J_parts).norm(), 1e-12 * (1 + L))
+            << c.name << " k = " << k;
+      }
+      VmAngles a_parts = start, a_combined = start;
+      Vec3 x_combined;
+      const bool aligned_parts = vm.aligned(rm, &a_parts);
+      const bool aligned_combined =
+          vm.aligned_position(rm, &a_combined, &x_combined);
+      ASSERT_EQ(aligned_parts, aligned_combined) << c.name << " k = " << k;
+      EXPECT_TRUE(a_parts == a_combined) << c.name << " k = " << k;
+      EXPECT_LE((x_combined - vm.position(a_parts)).norm(), 1e-12 * (1 + L))
+          << c.name << " k = " << k;
+    }
+  }
+}
+
 // ------------------------------------------------------------------ aligned
 
 // identity: aligned() turns the link onto the stylus axis (sphere, surface)
