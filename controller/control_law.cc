@@ -32,13 +32,20 @@ void active_columns(const VmJacobian& J, JointMask locked, VmJacobian* out) {
   }
 }
 
-Vec6 placement_residual(const VirtualMechanism& vm, const RmPose& rm,
-                        const VmAngles& theta) {
-  const VmPose pose = vm.pose(theta);
+namespace {
+// placement_residual from the pose at theta
+Vec6 residual_of_pose(const VirtualMechanism& vm, const RmPose& rm,
+                      const VmPose& pose) {
   Vec6 r;
   r.head<3>() = rm.p - pose.p;
   r.tail<3>() = -vm.geometric_orientation_error(pose, rm, nullptr);
   return r;
+}
+}  // namespace
+
+Vec6 placement_residual(const VirtualMechanism& vm, const RmPose& rm,
+                        const VmAngles& theta) {
+  return residual_of_pose(vm, rm, vm.pose(theta));
 }
 
 namespace {
@@ -54,34 +61,58 @@ bool weighs_orientation(const Vec6& w) {
 // weigh them: they would add exactly 0 to r^T W r and to J^T W r (the
 // geometric error is finite for finite input), and their atan2 is most of a
 // residual's cost under W_p
-Vec6 weighted_residual(const VirtualMechanism& vm, const RmPose& rm,
-                       const VmAngles& theta, bool orientation) {
-  if (orientation) return placement_residual(vm, rm, theta);
+Vec6 weighted_residual_of_position(const RmPose& rm, const Vec3& p) {
   Vec6 r;
-  r.head<3>() = rm.p - vm.position(theta);
+  r.head<3>() = rm.p - p;
   r.tail<3>().setZero();
   return r;
 }
+Vec6 weighted_residual(const VirtualMechanism& vm, const RmPose& rm,
+                       const VmAngles& theta, bool orientation) {
+  if (orientation) return placement_residual(vm, rm, theta);
+  return weighted_residual_of_position(rm, vm.position(theta));
+}
 }  // namespace
 
-PlacementResult place_gauss_newton(const VirtualMechanism& vm,
-                                   const RmPose& rm,
-                                   const PlacementOptions& options,
-                                   JointMask locked, VmAngles* theta) {
-  // Gauss-Newton with Levenberg-Marquardt damping (Nielsen's update): near
-  // a small-residual solution the damping shrinks and the steps are eq. 3.15
-  // itself; where Gauss-Newton overshoots (a point beyond 2L from a circle's
-  // pivot, where the plain iteration diverges at rate |1 - d/L|, or a
-  // surface probe stretched toward an RM it cannot reach) the damping grows
-  // and the step turns toward steepest descent.
+namespace {
+
+// Gauss-Newton over the M active (unlocked) joints, in fixed-size matrices:
+// the tick calls it with M = 1 (circle), 3 (sphere) or 3 and 5 (surface,
+// held or sliding), and perf put Eigen's dynamic-size LDLT, its triangular
+// solves and the resizes at a fifth of the sphere's Gauss-Newton tick.
+template <int M>
+PlacementResult gauss_newton_active(const VirtualMechanism& vm,
+                                    const RmPose& rm,
+                                    const PlacementOptions& options,
+                                    JointMask locked, VmAngles* theta,
+                                    const VmPose* pose_at_start,
+                                    const VmJacobian* J_at_start) {
+  using JacobianM = Eigen::Matrix<double, 6, M>;
+  using SquareM = Eigen::Matrix<double, M, M>;
+  using VecM = Eigen::Matrix<double, M, 1>;
   PlacementResult result;
   const Vec6& w = options.weights;
   const auto W = w.asDiagonal();
-  VmJacobian J, Ja;
-  SmallSquare A, A_damped;
-  VmAngles grad, step, full_step, trial, scale;
+  const int dof = vm.dof();
+  // the active joints' indices into theta
+  int active[kMaxVmDof];
+  for (int j = 0, k = 0; j < dof; ++j) {
+    if ((locked & (JointMask{1} << j)) == 0) active[k++] = j;
+  }
+  VmJacobian J;
+  JacobianM Ja;
+  SquareM A, A_damped;
+  VecM grad, step, scale;
+  VmAngles trial;
   const bool orientation = weighs_orientation(w);
-  Vec6 r = weighted_residual(vm, rm, *theta, orientation);
+  const bool given = pose_at_start != nullptr && J_at_start != nullptr;
+  Vec6 r;
+  if (given) {
+    r = orientation ? residual_of_pose(vm, rm, *pose_at_start)
+                    : weighted_residual_of_position(rm, pose_at_start->p);
+  } else {
+    r = weighted_residual(vm, rm, *theta, orientation);
+  }
   double cost = weighted_cost(r, w);
   double mu = options.relative_damping;  // relative to diag(A)
   double nu = 2.0;
@@ -93,48 +124,45 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
       // identity once the axes are far apart
       // (under W_p the angular rows meet only zero weights and zero
       // residual rows, so M is not needed there)
-      if (orientation) {
+      if (it == 0 && given) {
+        J = *J_at_start;
+        if (orientation) {
+          const Mat3 Me = vm.orientation_error_jacobian(*pose_at_start, rm);
+          J.bottomRows<3>() = (Me * J.bottomRows<3>()).eval();
+        }
+      } else if (orientation) {
         VmPose pose;
         vm.pose_jacobian(*theta, &pose, &J);
-        const Mat3 M = vm.orientation_error_jacobian(pose, rm);
-        J.bottomRows<3>() = (M * J.bottomRows<3>()).eval();
+        const Mat3 Me = vm.orientation_error_jacobian(pose, rm);
+        J.bottomRows<3>() = (Me * J.bottomRows<3>()).eval();
       } else {
         vm.jacobian(*theta, &J);
       }
-      active_columns(J, locked, &Ja);
-      if (Ja.cols() == 0) {
-        result.converged = true;
-        break;
-      }
+      for (int k = 0; k < M; ++k) Ja.col(k) = J.col(active[k]);
       A.noalias() = Ja.transpose() * W * Ja;
       grad.noalias() = Ja.transpose() * (W * r);
       fresh = false;
     }
-    const int m = static_cast<int>(Ja.cols());
-    const double mean_diag = A.diagonal().sum() / m + 1e-300;
+    const double mean_diag = A.diagonal().sum() / M + 1e-300;
     // solve with the columns scaled to unit diagonal: the surface mixes
     // prismatic (1) and revolute (L) columns, and unscaled its J^T W J is
     // conditioned ~1/(1 + L^2)^2, which leaves the steps at rounding noise
     // above the tolerance
     // a joint that W cannot see (the twist under the geometric residual,
     // every orientation joint under W_p) gets no step: it stays where it is
-    scale.resize(m);
-    for (int i = 0; i < m; ++i) {
+    for (int i = 0; i < M; ++i) {
       scale[i] = A(i, i) > 1e-12 * mean_diag ? 1.0 / std::sqrt(A(i, i)) : 0.0;
     }
     A_damped = scale.asDiagonal() * A * scale.asDiagonal();
-    for (int i = 0; i < m; ++i) {
+    for (int i = 0; i < M; ++i) {
       A_damped(i, i) = scale[i] > 0.0 ? A_damped(i, i) * (1.0 + mu) : 1.0;
     }
     step = scale.cwiseProduct(
         A_damped.ldlt().solve(scale.cwiseProduct(grad)).eval());
     result.iterations = it + 1;
     if (!step.allFinite()) break;
-    full_step = VmAngles::Zero(vm.dof());
-    for (int j = 0, k = 0; j < vm.dof(); ++j) {
-      if ((locked & (JointMask{1} << j)) == 0) full_step[j] = step[k++];
-    }
-    trial = *theta + full_step;
+    trial = *theta;
+    for (int k = 0; k < M; ++k) trial[active[k]] += step[k];
     vm.normalize(&trial);
     const Vec6 r_trial = weighted_residual(vm, rm, trial, orientation);
     const double cost_trial = weighted_cost(r_trial, w);
@@ -174,6 +202,53 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
   }
   result.cost = cost;
   return result;
+}
+
+}  // namespace
+
+PlacementResult place_gauss_newton(const VirtualMechanism& vm,
+                                   const RmPose& rm,
+                                   const PlacementOptions& options,
+                                   JointMask locked, VmAngles* theta,
+                                   const VmPose* pose_at_start,
+                                   const VmJacobian* J_at_start) {
+  // Gauss-Newton with Levenberg-Marquardt damping (Nielsen's update): near
+  // a small-residual solution the damping shrinks and the steps are eq. 3.15
+  // itself; where Gauss-Newton overshoots (a point beyond 2L from a circle's
+  // pivot, where the plain iteration diverges at rate |1 - d/L|, or a
+  // surface probe stretched toward an RM it cannot reach) the damping grows
+  // and the step turns toward steepest descent.
+  int active = 0;
+  for (int j = 0; j < vm.dof(); ++j) {
+    if ((locked & (JointMask{1} << j)) == 0) ++active;
+  }
+  switch (active) {
+    case 1:
+      return gauss_newton_active<1>(vm, rm, options, locked, theta,
+                                    pose_at_start, J_at_start);
+    case 2:
+      return gauss_newton_active<2>(vm, rm, options, locked, theta,
+                                    pose_at_start, J_at_start);
+    case 3:
+      return gauss_newton_active<3>(vm, rm, options, locked, theta,
+                                    pose_at_start, J_at_start);
+    case 4:
+      return gauss_newton_active<4>(vm, rm, options, locked, theta,
+                                    pose_at_start, J_at_start);
+    case 5:
+      return gauss_newton_active<5>(vm, rm, options, locked, theta,
+                                    pose_at_start, J_at_start);
+    default: {
+      // every joint locked: nothing to move
+      PlacementResult result;
+      result.converged = true;
+      result.cost =
+          weighted_cost(weighted_residual(vm, rm, *theta,
+                                          weighs_orientation(options.weights)),
+                        options.weights);
+      return result;
+    }
+  }
 }
 
 ProjectionResult project_motion_force(const VmJacobian& J, const Vec6& W_A,

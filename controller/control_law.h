@@ -52,11 +52,16 @@ Vec6 placement_residual(const VirtualMechanism& vm, const RmPose& rm,
 // Iterates eq. 3.15/3.16, delta = (J^T W J)^-1 J^T W r, theta += delta,
 // from *theta (the warm start) and leaves the result in *theta, normalised.
 // The step carries Levenberg-Marquardt damping that adapts to how well the
-// linear model predicted the cost (see control_law.cc).
+// linear model predicted the cost (see control_law.cc). A caller that has
+// X_V and J_V at the starting *theta already (the servo tick, from the
+// closed form it starts from) passes them, and the first iteration uses them
+// instead of computing them again; nullptr (both): computed.
 PlacementResult place_gauss_newton(const VirtualMechanism& vm,
                                    const RmPose& rm,
                                    const PlacementOptions& options,
-                                   JointMask locked, VmAngles* theta);
+                                   JointMask locked, VmAngles* theta,
+                                   const VmPose* pose_at_start = nullptr,
+                                   const VmJacobian* J_at_start = nullptr);
 
 // ------------------------------------------------------------- projection
 

@@ -206,19 +206,25 @@ ControlStatus Controller::place(const RmPose& rm, JointMask locked,
   // the closed form: nearest point (circle, sphere, sticking surface); for
   // a sliding surface the probe aligned with the stylus, tip on the plane.
   // Where it is the placement, its pose and J_V come with it
+  // (and Gauss-Newton's first iteration takes them where it starts from
+  // the closed form's answer: the circle's and the sphere's nearest point)
   seed_ = theta_v_;
   bool seed_ok;
+  bool seed_posed = false;
   if (contact_sliding) {
     seed_ok = vm_->aligned(rm, &seed_);
-  } else if (closed_form) {
+  } else if (closed_form || vm_->nearest_minimises_distance()) {
     seed_ok = vm_->nearest_pose_jacobian(rm, &seed_, pose, &J_);
-    *posed = seed_ok;
+    seed_posed = seed_ok;
   } else {
     seed_ok = vm_->nearest(rm, &seed_);
   }
   if (!seed_ok) st |= kStatusRmAtPivot;
+  // where *pose and J_ were computed (seed_ is reused below)
+  const VmAngles posed_at = seed_;
   if (!placed_ && seed_ok) theta_v_ = seed_;
   if (closed_form) {
+    *posed = seed_posed;
     if (seed_ok) theta_v_ = seed_;
     out->placement_iterations = 0;
     // r^T W r at theta_V: evaluate() computes it from the pose it needs
@@ -237,6 +243,11 @@ ControlStatus Controller::place(const RmPose& rm, JointMask locked,
           r_warm.dot(w.cwiseProduct(r_warm))) {
         theta_v_ = seed_;
       }
+    } else if (vm_->nearest_minimises_distance() && w[1] == w[0] &&
+               w[2] == w[0]) {
+      // W_p with equal weights is the distance, and the seed minimises it
+      // over the whole path: the warm start cannot be lower
+      theta_v_ = seed_;
     } else {
       // the orientation rows would add exactly 0: positions only
       const Vec3 r_warm = rm.p - vm_->position(theta_v_);
@@ -267,8 +278,13 @@ ControlStatus Controller::place(const RmPose& rm, JointMask locked,
       }
     }
   }
+  // the pose and J_V at the seed serve while theta_V is still the seed,
+  // bit for bit (a converged step below the angles' ulp leaves it so)
+  const bool start_posed = seed_posed && theta_v_ == posed_at;
   const PlacementResult res = place_gauss_newton(
-      *vm_, rm, params_.placement_options, locked, &theta_v_);
+      *vm_, rm, params_.placement_options, locked, &theta_v_,
+      start_posed ? pose : nullptr, start_posed ? &J_ : nullptr);
+  *posed = start_posed && theta_v_ == posed_at;
   if (!res.converged) st |= kStatusPlacementNotConverged;
   out->placement_iterations = res.iterations;
   out->placement_cost = res.cost;

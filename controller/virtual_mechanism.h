@@ -126,6 +126,13 @@ class VirtualMechanism {
   virtual bool nearest(const RmPose& rm, VmAngles* theta) const = 0;
   virtual bool aligned(const RmPose& rm, VmAngles* theta) const = 0;
 
+  // Whether nearest() returns the minimiser of |p_RM - X_V(theta)| over the
+  // whole path (not only a nearby one): true for the circle and the sphere,
+  // whose nearest point is their closed form's answer (§3.3.1, §3.4.1).
+  // Under W_p with equal position weights, Gauss-Newton can then start from
+  // it without comparing it with the warm start.
+  virtual bool nearest_minimises_distance() const { return false; }
+
   // What a closed-form servo tick asks for, each in one call: nearest() and,
   // where it succeeds, pose_jacobian() at the angles it set; aligned() and
   // then the handle's position at *theta (changed or kept). A VM whose
@@ -237,6 +244,7 @@ class CircleVm final : public VirtualMechanism {
   bool aligned(const RmPose& rm, VmAngles* theta) const override;
   bool nearest_pose_jacobian(const RmPose& rm, VmAngles* theta, VmPose* pose,
                              VmJacobian* J) const override;
+  bool nearest_minimises_distance() const override { return true; }
   bool aligned_position(const RmPose& rm, VmAngles* theta,
                         Vec3* p) const override;
   Vec3 thesis_orientation_error(const VmAngles& theta_v,
@@ -265,6 +273,7 @@ class SphereVm final : public VirtualMechanism {
   bool aligned(const RmPose& rm, VmAngles* theta) const override;
   bool nearest_pose_jacobian(const RmPose& rm, VmAngles* theta, VmPose* pose,
                              VmJacobian* J) const override;
+  bool nearest_minimises_distance() const override { return true; }
   bool aligned_position(const RmPose& rm, VmAngles* theta,
                         Vec3* p) const override;
   Vec3 thesis_orientation_error(const VmAngles& theta_v,
