@@ -26,6 +26,7 @@ HandScript::HandScript(const CaseParams& c, const VmParams& vm)
     : script_(c.script.kind), kind_(vm.kind) {
   pivot_ = vm.pivot_mm;
   n_ = vm.R_pivot.col(2);
+  n_unit_ = n_.normalized();
   length_mm_ = vm.length_mm;
   off_mm_ = c.script.off_mm;
   misalign_rad_ = c.script.misalign_rad;
@@ -164,7 +165,8 @@ ScriptPose HandScript::raw(int segment, double t_s) const {
       pose.p_mm = pivot_ + length_mm_ * two_swings() * r0_;
       break;
     case Shape::kSpin:
-      pose.axis = rotate(axis0_, n_, misalign_rad_ * two_swings());
+      pose.axis = Eigen::AngleAxisd(misalign_rad_ * two_swings(), n_unit_) *
+                  axis0_;
       break;
     case Shape::kOffOut:
       pose.p_mm = p0_ + off_mm_ * r0_;
@@ -192,9 +194,11 @@ ScriptPose HandScript::raw(int segment, double t_s) const {
       // start pose
       const double phi = sweep_rad_ * std::sin(kTwoPi * tau / T);
       const double across = sweep_mm_ * std::sin(4.0 * kTwoPi * tau / T);
-      const Vec3 r = rotate(r0_, n_, phi);
+      // one rotation for both: what rotate() would build twice
+      const Mat3 turn = Eigen::AngleAxisd(phi, n_unit_).toRotationMatrix();
+      const Vec3 r = turn * r0_;
       pose.p_mm = pivot_ + (length_mm_ + across) * r;
-      pose.axis = rotate(axis0_, n_, phi);
+      pose.axis = turn * axis0_;
       break;
     }
   }

@@ -74,6 +74,7 @@ class HandScript {
   std::vector<ScriptSegment> segments_;
   VmKind kind_;
   Vec3 pivot_, n_, r0_, t0_, p0_, axis0_;
+  Vec3 n_unit_;  // n_.normalized(), for the moving segments' rotations
   double length_mm_, off_mm_, misalign_rad_, sweep_mm_, sweep_rad_;
   double blend_s_ = 0.3;
   // per segment: its shape; whether its pose moves with time; its pose
