@@ -15,8 +15,14 @@
 //   controller, delay line, then T/h physics steps with the hand).
 // items/s counts physics steps in all three, so the overhead of the loop is
 // items/s(BM_BareStep) / items/s(BM_ClosedLoopTick) - 1. The second argument
-// is the physics setting: 0 the scene's own (RK4, h = T = 1 ms), 1 the
-// Euler step at 0.2 ms the scenes used before the precision study.
+// is the physics setting: 0 the scene's own (RK4, h = T = 1 ms, the PGS
+// constraint solver), 1 the Euler step at 0.2 ms the scenes used before the
+// precision study. Every benchmark stepping MuJoCo reports solver_iter, the
+// constraint solver's iterations in a step's last evaluation, averaged: the
+// same model costs more per step where the solver sweeps more often (PGS
+// sweeps about once for the resting or held arm, about three times while
+// the script moves it), so this tells the state's share of a difference
+// from the code's.
 //
 // BM_RunAll: sim::run_cases on the six thesis cases, 20 s each, on two
 // threads, writing nothing; one iteration is one `run --all`.
@@ -112,6 +118,7 @@ void BM_ClosedLoopTick(benchmark::State& state) {
   warm_loop(&loop);
   TraceRow row;
   long ticks = 0;
+  long solver_iterations = 0;
   for (auto _ : state) {
     // the script ends at the run's duration; start again rather than run
     // past it
@@ -121,9 +128,14 @@ void BM_ClosedLoopTick(benchmark::State& state) {
       state.ResumeTiming();
     }
     loop.tick(&row);
+    solver_iterations += loop.data()->solver_iter;
   }
   state.SetItemsProcessed(state.iterations() * loop.substeps());
   state.counters["substeps"] = loop.substeps();
+  // as in step_model: the last evaluation of the tick's last step
+  state.counters["solver_iter"] =
+      static_cast<double>(solver_iterations) /
+      static_cast<double>(state.iterations());
 }
 
 void BM_RunAll(benchmark::State& state) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
@@ -61,6 +62,12 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
   if (!data_) throw SimError(path_ + ": mj_makeData failed");
   hand_ = std::make_unique<SimHand>(model_.get(), data_.get(),
                                     hand_params(config_), path_);
+  {
+    // the grip site's offset and rotation in the stylus body, fixed
+    const int g = hand_->grip_site();
+    grip_local_ = Vec3(model_->site_pos + 3 * g);
+    mju_quat2Mat(R_site_.data(), model_->site_quat + 4 * g);
+  }
   build_controller();
   build_device_chain();
   qpos_before_.assign(static_cast<std::size_t>(model_->nq), 0.0);
@@ -317,40 +324,50 @@ void ClosedLoop::set_manual_target(const HandTargetState& target) {
 }
 
 ScriptPose ClosedLoop::wrist_pose_of(const HandTargetState& grip) const {
-  const mjModel* m = model_.get();
-  const int g = hand_->grip_site();
-  const Vec3 grip_local(m->site_pos + 3 * g);
-  RowMat3 R_site;
-  mju_quat2Mat(R_site.data(), m->site_quat + 4 * g);
   // undo set_hand_target's grip = wrist + R grip_local, R_grip = R R_site
-  const Mat3 R = grip.R * R_site.transpose();
+  const Mat3 R = grip.R * R_site_.transpose();
   ScriptPose pose;
-  pose.p_mm = base_to_device_mm(params_.omni, grip.p_m - R * grip_local);
+  pose.p_mm = base_to_device_mm(params_.omni, grip.p_m - R * grip_local_);
   pose.axis = base_to_device_vector(R.col(2));
   return pose;
 }
 
-void ClosedLoop::set_hand_target(double t_s) {
-  const OmniParams& omni = params_.omni;
-  const mjModel* m = model_.get();
-  // the grip site's offset and rotation in the stylus body
-  const int g = hand_->grip_site();
-  const Vec3 grip_local(m->site_pos + 3 * g);
-  RowMat3 R_site;
-  mju_quat2Mat(R_site.data(), m->site_quat + 4 * g);
+void ClosedLoop::set_hand_target(double t_s) { (void)script_target(t_s); }
 
+const Mat3& ClosedLoop::stylus_turned_to(const Vec3& axis_base) {
+  // the script's axis changes only in its moving and blending stretches,
+  // and the two evaluations per tick (t and t + dt) alternate: two entries
+  // spare turn_to_axis() wherever the axis is held
+  for (TurnMemo& e : turn_memo_) {
+    if (e.valid && std::memcmp(e.axis_base.data(), axis_base.data(),
+                               3 * sizeof(double)) == 0) {
+      return e.R;
+    }
+  }
+  TurnMemo& e = turn_memo_[turn_memo_next_];
+  turn_memo_next_ = 1 - turn_memo_next_;
+  e.axis_base = axis_base;
+  e.R = turn_to_axis(R_start_base_, axis_base);
+  e.valid = true;
+  return e.R;
+}
+
+ScriptPose ClosedLoop::script_target(double t_s) {
+  const OmniParams& omni = params_.omni;
   auto target_at = [&](double t, Vec3* p_grip, Mat3* R_grip) {
     const ScriptPose pose = script_->at(t);
-    const Mat3 R = turn_to_axis(R_start_base_, device_to_base_vector(pose.axis));
+    const Mat3& R = stylus_turned_to(device_to_base_vector(pose.axis));
     // the stylus body's origin is the wrist centre
     const Vec3 wrist = device_mm_to_base(omni, pose.p_mm);
-    *p_grip = wrist + R * grip_local;
-    *R_grip = R * R_site;
+    *p_grip = wrist + R * grip_local_;
+    *R_grip = R * R_site_;
+    return pose;
   };
   HandTargetState target;
   // past the script's end the hand holds its last target still
   const double t_end_s = duration_s_;
-  target_at(std::min(t_s, t_end_s), &target.p_m, &target.R);
+  const ScriptPose pose =
+      target_at(std::min(t_s, t_end_s), &target.p_m, &target.R);
   // the target's velocity by a forward difference over a small interval
   const double dt = 1e-5;
   Vec3 p2;
@@ -359,7 +376,8 @@ void ClosedLoop::set_hand_target(double t_s) {
   target.v_m_s = (p2 - target.p_m) / dt;
   const Eigen::AngleAxisd dR(R2 * target.R.transpose());
   target.w_rad_s = dR.angle() * dR.axis() / dt;
-  hand_->set_target(m, data_.get(), target);
+  hand_->set_target(model_.get(), data_.get(), target);
+  return pose;
 }
 
 // the mechanism works in the controller's length unit
@@ -382,8 +400,8 @@ void ClosedLoop::tick(TraceRow* row) {
     hand_->set_target(model_.get(), data_.get(), manual_target_);
     row->hand_target = wrist_pose_of(manual_target_);
   } else {
-    set_hand_target(t);
-    row->hand_target = script_->at(t_script);
+    // the script's pose at t_script, which the hand's target was made from
+    row->hand_target = script_target(t);
   }
 
   injector_->set_time_s(t);

@@ -227,6 +227,11 @@ class ClosedLoop {
   bool check_step(double t_s, double time_before);
   // the wrist pose (device frame) a grip target asks for
   ScriptPose wrist_pose_of(const HandTargetState& grip) const;
+  // set_hand_target(t_s); returns the script's pose at min(t_s, duration_s)
+  ScriptPose script_target(double t_s);
+  // turn_to_axis(R_start_base_, axis_base), remembered for the last two
+  // axes (compared bit for bit)
+  const Mat3& stylus_turned_to(const Vec3& axis_base);
 
   std::string path_;
   ModelPtr model_;
@@ -243,6 +248,17 @@ class ClosedLoop {
   ControlOutput reference_out_;
   Joints q_start_dh_ = Joints::Zero();
   Mat3 R_start_base_ = Mat3::Identity();  // stylus frame at the start pose
+  // the grip site in the stylus body: offset (m) and rotation
+  Vec3 grip_local_ = Vec3::Zero();
+  Eigen::Matrix<double, 3, 3, Eigen::RowMajor> R_site_ =
+      Eigen::Matrix<double, 3, 3, Eigen::RowMajor>::Identity();
+  struct TurnMemo {
+    bool valid = false;
+    Vec3 axis_base = Vec3::Zero();
+    Mat3 R = Mat3::Identity();
+  };
+  std::array<TurnMemo, 2> turn_memo_{};
+  int turn_memo_next_ = 0;
   int substeps_ = 1;
   std::int64_t ticks_per_run_ = 0;
   double duration_s_ = 0.0;  // the script's, read once (the tick reads it)

@@ -26,6 +26,7 @@ HandScript::HandScript(const CaseParams& c, const VmParams& vm)
     : script_(c.script.kind), kind_(vm.kind) {
   pivot_ = vm.pivot_mm;
   n_ = vm.R_pivot.col(2);
+  n_unit_ = n_.normalized();
   length_mm_ = vm.length_mm;
   off_mm_ = c.script.off_mm;
   misalign_rad_ = c.script.misalign_rad;
@@ -64,6 +65,7 @@ HandScript::HandScript(const CaseParams& c, const VmParams& vm)
 
   if (script_ == ScriptKind::kHold) {
     segments_ = {{"hold", 0.0, D, true}};
+    prepare();
     return;
   }
   if (script_ == ScriptKind::kPivot) {
@@ -72,12 +74,14 @@ HandScript::HandScript(const CaseParams& c, const VmParams& vm)
     segments_ = {{"at_pivot", 0.0, 0.4 * D, true},
                  {"through_pivot", 0.4 * D, D, false}};
     blend_s_ = std::min(0.3, 0.05 * D);
+    prepare();
     return;
   }
   if (script_ == ScriptKind::kSpin) {
     // the point held, the stylus swung about the VM's normal
     segments_ = {{"settle", 0.0, 0.1 * D, true}, {"spin", 0.1 * D, D, false}};
     blend_s_ = std::min(0.3, 0.025 * D);
+    prepare();
     return;
   }
   // the thesis script, in twentieths of the run (20 s by default)
@@ -92,6 +96,40 @@ HandScript::HandScript(const CaseParams& c, const VmParams& vm)
       {"sweep", 13 * u, 20 * u, false},
   };
   blend_s_ = std::min(0.3, 0.25 * u);
+  prepare();
+}
+
+HandScript::Shape HandScript::shape_of(const std::string& name) {
+  if (name == "at_pivot") return Shape::kAtPivot;
+  if (name == "through_pivot") return Shape::kThroughPivot;
+  if (name == "spin") return Shape::kSpin;
+  if (name == "off_out") return Shape::kOffOut;
+  if (name == "off_out_misaligned") return Shape::kOffOutMisaligned;
+  if (name == "off_in") return Shape::kOffIn;
+  if (name == "on_misaligned_a") return Shape::kOnMisalignedA;
+  if (name == "on_misaligned_b") return Shape::kOnMisalignedB;
+  if (name == "sweep") return Shape::kSweep;
+  return Shape::kStart;  // hold, settle: the start pose
+}
+
+void HandScript::prepare() {
+  const std::size_t n = segments_.size();
+  shapes_.resize(n);
+  moving_.resize(n);
+  held_pose_.assign(n, ScriptPose{});
+  blend_from_.assign(n, ScriptPose{});
+  for (std::size_t i = 0; i < n; ++i) {
+    shapes_[i] = shape_of(segments_[i].name);
+    moving_[i] = shapes_[i] == Shape::kThroughPivot ||
+                 shapes_[i] == Shape::kSpin || shapes_[i] == Shape::kSweep;
+  }
+  // the same raw() that a moving segment runs at every call, so a held pose
+  // is bit for bit what it would be if worked out at each tick
+  for (std::size_t i = 0; i < n; ++i) {
+    const int k = static_cast<int>(i);
+    if (!moving_[i]) held_pose_[i] = raw(k, segments_[i].t0_s);
+    if (i > 0) blend_from_[i] = raw(k - 1, segments_[i].t0_s);
+  }
 }
 
 int HandScript::segment_at(double t_s) const {
@@ -105,7 +143,7 @@ ScriptPose HandScript::raw(int segment, double t_s) const {
   ScriptPose pose;
   pose.p_mm = p0_;
   pose.axis = axis0_;
-  const std::string& name = segments_[static_cast<std::size_t>(segment)].name;
+  const Shape shape = shapes_[static_cast<std::size_t>(segment)];
   // misalignment turns the stylus toward the tangent: for the circle about
   // its normal (theta_R moves along the path); for the sphere the second
   // on-path hold tilts it about the tangent instead (the polar angle)
@@ -117,47 +155,69 @@ ScriptPose HandScript::raw(int segment, double t_s) const {
     const double u = std::max(0.0, t_s - seg.t0_s) / (seg.t1_s - seg.t0_s);
     return std::sin(2.0 * kTwoPi * u);
   };
-  if (name == "at_pivot") {
-    pose.p_mm = pivot_;
-  } else if (name == "through_pivot") {
-    pose.p_mm = pivot_ + length_mm_ * two_swings() * r0_;
-  } else if (name == "spin") {
-    pose.axis = rotate(axis0_, n_, misalign_rad_ * two_swings());
-  } else if (name == "off_out") {
-    pose.p_mm = p0_ + off_mm_ * r0_;
-  } else if (name == "off_out_misaligned") {
-    pose.p_mm = p0_ + off_mm_ * r0_;
-    pose.axis = rotate(axis0_, m, misalign_rad_);
-  } else if (name == "off_in") {
-    pose.p_mm = p0_ - off_mm_ * r0_;
-  } else if (name == "on_misaligned_a") {
-    pose.axis = rotate(axis0_, m, misalign_rad_);
-  } else if (name == "on_misaligned_b") {
-    pose.axis = kind_ == VmKind::kSphere
-                    ? rotate(axis0_, t0_, misalign_rad_)
-                    : rotate(axis0_, m, -misalign_rad_);
-  } else if (name == "sweep") {
-    const ScriptSegment& s = segments_[static_cast<std::size_t>(segment)];
-    const double T = s.t1_s - s.t0_s;
-    const double tau = std::max(0.0, t_s - s.t0_s);
-    // one slow pass along the path, four across it, both starting at the
-    // start pose
-    const double phi = sweep_rad_ * std::sin(kTwoPi * tau / T);
-    const double across = sweep_mm_ * std::sin(4.0 * kTwoPi * tau / T);
-    const Vec3 r = rotate(r0_, n_, phi);
-    pose.p_mm = pivot_ + (length_mm_ + across) * r;
-    pose.axis = rotate(axis0_, n_, phi);
+  switch (shape) {
+    case Shape::kStart:
+      break;
+    case Shape::kAtPivot:
+      pose.p_mm = pivot_;
+      break;
+    case Shape::kThroughPivot:
+      pose.p_mm = pivot_ + length_mm_ * two_swings() * r0_;
+      break;
+    case Shape::kSpin:
+      pose.axis = Eigen::AngleAxisd(misalign_rad_ * two_swings(), n_unit_) *
+                  axis0_;
+      break;
+    case Shape::kOffOut:
+      pose.p_mm = p0_ + off_mm_ * r0_;
+      break;
+    case Shape::kOffOutMisaligned:
+      pose.p_mm = p0_ + off_mm_ * r0_;
+      pose.axis = rotate(axis0_, m, misalign_rad_);
+      break;
+    case Shape::kOffIn:
+      pose.p_mm = p0_ - off_mm_ * r0_;
+      break;
+    case Shape::kOnMisalignedA:
+      pose.axis = rotate(axis0_, m, misalign_rad_);
+      break;
+    case Shape::kOnMisalignedB:
+      pose.axis = kind_ == VmKind::kSphere
+                      ? rotate(axis0_, t0_, misalign_rad_)
+                      : rotate(axis0_, m, -misalign_rad_);
+      break;
+    case Shape::kSweep: {
+      const ScriptSegment& s = segments_[static_cast<std::size_t>(segment)];
+      const double T = s.t1_s - s.t0_s;
+      const double tau = std::max(0.0, t_s - s.t0_s);
+      // one slow pass along the path, four across it, both starting at the
+      // start pose
+      const double phi = sweep_rad_ * std::sin(kTwoPi * tau / T);
+      const double across = sweep_mm_ * std::sin(4.0 * kTwoPi * tau / T);
+      // one rotation for both: what rotate() would build twice
+      const Mat3 turn = Eigen::AngleAxisd(phi, n_unit_).toRotationMatrix();
+      const Vec3 r = turn * r0_;
+      pose.p_mm = pivot_ + (length_mm_ + across) * r;
+      pose.axis = turn * axis0_;
+      break;
+    }
   }
   return pose;
 }
 
+// raw(), from the poses prepare() kept where they do not move
+ScriptPose HandScript::evaluate(int segment, double t_s) const {
+  const auto i = static_cast<std::size_t>(segment);
+  return moving_[i] ? raw(segment, t_s) : held_pose_[i];
+}
+
 ScriptPose HandScript::at(double t_s) const {
   const int k = segment_at(t_s);
-  ScriptPose pose = raw(k, t_s);
+  ScriptPose pose = evaluate(k, t_s);
   const ScriptSegment& s = segments_[static_cast<std::size_t>(k)];
   if (k > 0 && t_s - s.t0_s < blend_s_) {
     // blend in from where the previous segment ended
-    const ScriptPose from = raw(k - 1, s.t0_s);
+    const ScriptPose& from = blend_from_[static_cast<std::size_t>(k)];
     const double w = smoothstep((t_s - s.t0_s) / blend_s_);
     pose.p_mm = (1.0 - w) * from.p_mm + w * pose.p_mm;
     const Eigen::Quaterniond q =

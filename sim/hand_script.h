@@ -57,14 +57,33 @@ class HandScript {
   const Vec3& tangent() const { return t0_; }
 
  private:
+  // what a segment does with the pose; named by ScriptSegment::name
+  enum class Shape {
+    kStart, kAtPivot, kThroughPivot, kSpin, kOffOut, kOffOutMisaligned,
+    kOffIn, kOnMisalignedA, kOnMisalignedB, kSweep
+  };
+  static Shape shape_of(const std::string& segment_name);
+  // the segments' shapes, and the poses that do not depend on time, worked
+  // out once (at() runs every servo tick, twice for the hand's velocity)
+  void prepare();
   ScriptPose raw(int segment, double t_s) const;
+  ScriptPose evaluate(int segment, double t_s) const;
+
 
   ScriptKind script_;
   std::vector<ScriptSegment> segments_;
   VmKind kind_;
   Vec3 pivot_, n_, r0_, t0_, p0_, axis0_;
+  Vec3 n_unit_;  // n_.normalized(), for the moving segments' rotations
   double length_mm_, off_mm_, misalign_rad_, sweep_mm_, sweep_rad_;
   double blend_s_ = 0.3;
+  // per segment: its shape; whether its pose moves with time; its pose
+  // when it does not; the pose the previous segment ended at (its blend's
+  // start)
+  std::vector<Shape> shapes_;
+  std::vector<char> moving_;
+  std::vector<ScriptPose> held_pose_;
+  std::vector<ScriptPose> blend_from_;
 };
 
 }  // namespace vmh::sim

@@ -6,7 +6,9 @@
 // torque held over each servo tick), over the first `duration_s` of the
 // case's script, with the sensor quantisation off (quantize=0) so that the
 // readings are a smooth function of the state and the integrators' orders
-// can show. The trajectory is the true wrist centre (omni_fk of MuJoCo's
+// can show, and with MuJoCo's Newton constraint solver whatever the scene
+// sets (the case scenes' PGS stops on a tolerance; over a fine rung's many
+// steps its residual would hide the integrators' error). The trajectory is the true wrist centre (omni_fk of MuJoCo's
 // joint angles, device frame, mm) and the stylus axis at the end of every
 // servo tick; runs are compared tick by tick with the reference, RK4 at a
 // step far below the ladder's smallest. A second reference, at a coarser
