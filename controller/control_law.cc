@@ -164,7 +164,12 @@ PlacementResult gauss_newton_active(const VirtualMechanism& vm,
     trial = *theta;
     for (int k = 0; k < M; ++k) trial[active[k]] += step[k];
     vm.normalize(&trial);
-    const Vec6 r_trial = weighted_residual(vm, rm, trial, orientation);
+    // a step below the angles' ulp leaves them as they were (the usual case
+    // from the closed form's answer, where the step is ~1e-17 rad): the
+    // residual is the one in hand
+    const Vec6 r_trial = trial == *theta
+                             ? r
+                             : weighted_residual(vm, rm, trial, orientation);
     const double cost_trial = weighted_cost(r_trial, w);
     // predicted decrease of r^T W r for the linearised residual
     const double predicted = step.dot(2.0 * grad - A * step);
