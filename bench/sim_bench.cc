@@ -11,6 +11,9 @@
 //   the closed loop reaches after 0.2 s, so both start from the same pose.
 // - BM_HandStep: the same with the hand's impedance applied at every step
 //   through mjcb_control: the physics of the scene, without the controller.
+// - BM_ReplayStep (case 1): bare mj_step from the loop's own recorded
+//   states, with its command and hand wrench held: the loop's motion
+//   without the loop (see below).
 // - BM_ClosedLoopTick: ClosedLoop::tick, one servo period (script, sensor,
 //   controller, delay line, then T/h physics steps with the hand).
 // items/s counts physics steps in all three, so the overhead of the loop is
@@ -112,6 +115,66 @@ void BM_HeldHandStep(benchmark::State& state) {
   state.counters["time_s"] = d->time;
 }
 
+// BM_ReplayStep: bare mj_step (no control callback, no controller, no
+// script) from the loop's own states: 10 s of the loop, after the same 0.2 s
+// warm-up, are recorded tick by tick (qpos, qvel, the solver's warm start,
+// the motor command, and the hand's wrench of the tick's last RK4 stage),
+// and each iteration restores one tick's state and steps it with that
+// command and wrench held. So MuJoCo steps the moving, held arm that
+// BM_ClosedLoopTick steps (its constraint solver iterates as often), where
+// BM_BareStep's copy coasts to rest: BM_ClosedLoopTick / BM_ReplayStep is
+// the loop's own cost (controller, script, hand at every stage, trace), and
+// BM_ReplayStep / BM_BareStep what the motion costs MuJoCo. The restore
+// copies ~30 numbers per step and is timed with it.
+void BM_ReplayStep(benchmark::State& state) {
+  ClosedLoop loop(case_scene(static_cast<int>(state.range(0))),
+                  setting(state.range(1)));
+  warm_loop(&loop);
+  const mjModel* m = loop.model();
+  const int nu = m->nu, nv = m->nv, nq = m->nq;
+  const int ticks = 10000;
+  struct Tape {
+    std::vector<mjtNum> qpos, qvel, warmstart, ctrl, wrench, time;
+    std::vector<int> steps;
+  } tape;
+  TraceRow row;
+  for (int k = 0; k < ticks; ++k) {
+    const mjData* d = loop.data();
+    tape.qpos.insert(tape.qpos.end(), d->qpos, d->qpos + nq);
+    tape.qvel.insert(tape.qvel.end(), d->qvel, d->qvel + nv);
+    tape.warmstart.insert(tape.warmstart.end(), d->qacc_warmstart,
+                          d->qacc_warmstart + nv);
+    tape.time.push_back(d->time);
+    loop.tick(&row);
+    tape.ctrl.insert(tape.ctrl.end(), d->ctrl, d->ctrl + nu);
+    tape.wrench.insert(tape.wrench.end(), d->qfrc_applied,
+                       d->qfrc_applied + nv);
+    tape.steps.push_back(row.substeps);
+  }
+  DataPtr data(mj_makeData(m));
+  mjData* d = data.get();
+  mj_copyData(d, m, loop.data());
+  std::size_t k = 0;
+  long solver_iterations = 0, physics_steps = 0;
+  for (auto _ : state) {
+    if (k == static_cast<std::size_t>(ticks)) k = 0;
+    mju_copy(d->qpos, &tape.qpos[k * nq], nq);
+    mju_copy(d->qvel, &tape.qvel[k * nv], nv);
+    mju_copy(d->qacc_warmstart, &tape.warmstart[k * nv], nv);
+    mju_copy(d->ctrl, &tape.ctrl[k * nu], nu);
+    mju_copy(d->qfrc_applied, &tape.wrench[k * nv], nv);
+    d->time = tape.time[k];
+    for (int i = 0; i < tape.steps[k]; ++i) mj_step(m, d);
+    solver_iterations += d->solver_iter;
+    physics_steps += tape.steps[k];
+    ++k;
+  }
+  state.SetItemsProcessed(physics_steps);
+  state.counters["solver_iter"] =
+      static_cast<double>(solver_iterations) /
+      static_cast<double>(state.iterations());
+}
+
 void BM_ClosedLoopTick(benchmark::State& state) {
   ClosedLoop loop(case_scene(static_cast<int>(state.range(0))),
                   setting(state.range(1)));
@@ -167,6 +230,7 @@ void cases_and_settings(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_BareStep)->Apply(cases_and_settings);
 BENCHMARK(BM_HandStep)->Apply(cases_and_settings);
 BENCHMARK(BM_HeldHandStep)->Args({1, 0});
+BENCHMARK(BM_ReplayStep)->Args({1, 0});
 BENCHMARK(BM_ClosedLoopTick)->Apply(cases_and_settings);
 BENCHMARK(BM_RunAll)->Iterations(1)->UseRealTime()->Unit(benchmark::kSecond);
 
