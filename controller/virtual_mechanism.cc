@@ -413,8 +413,8 @@ namespace {
 // are scale-free, so d needs no normalising, and atan2 keeps its accuracy
 // near the poles, where acos loses half its digits. Returns the sines and
 // cosines of the angles set, from d itself: s2 = |d_xy|/|d|, c2 = -d_z/|d|,
-// (c1, s1) = d_xy/|d_xy| (theta1's own on the pole); callers that need only
-// the angles drop them (inline: the compiler drops their arithmetic too).
+// (c1, s1) = d_xy/|d_xy| (theta1's own on the pole); nearest() and
+// aligned(), which need only the angles, ignore them.
 SphereTrig sphere_angles(const Vec3& d, VmAngles* theta) {
   const double rho2 = d.x() * d.x() + d.y() * d.y();
   const double n2 = rho2 + d.z() * d.z();
