@@ -61,47 +61,35 @@ ClosedLoop& warm_loop(ClosedLoop* loop) {
   return *loop;
 }
 
-// `with_hand`: the loop's own data, whose hand (registered for it, sim/hand.h)
-// adds its wrench at every step; without: a copy of that data, which has no
-// hand registered, so mj_step is bare MuJoCo
-void step_model(benchmark::State& state, bool with_hand) {
+// the constraint solver's iterations per benchmark iteration (MuJoCo's
+// count of the last evaluation of each step)
+void report_solver_iterations(benchmark::State& state, long total) {
+  state.counters["solver_iter"] =
+      static_cast<double>(total) / static_cast<double>(state.iterations());
+}
+
+// What step_model steps, from the state the loop reaches after 0.2 s:
+// - kBare: a copy of the loop's data, which has no hand registered, so
+//   mj_step is bare MuJoCo;
+// - kHand: the loop's own data, whose hand (registered for it, sim/hand.h)
+//   adds its wrench at every step;
+// - kHeldHand: the loop's own data with the hand's callback replaced by one
+//   that does nothing, so that qfrc_applied keeps the hand's last wrench:
+//   the state kHand steps, without the hand's cost.
+enum class Stepped { kBare, kHand, kHeldHand };
+
+void noop_control(const mjModel*, mjData*) {}
+
+void step_model(benchmark::State& state, Stepped what) {
   ClosedLoop loop(case_scene(static_cast<int>(state.range(0))),
                   setting(state.range(1)));
   warm_loop(&loop);
   const mjModel* m = loop.model();
   DataPtr copy(mj_makeData(m));
   mj_copyData(copy.get(), m, loop.data());
-  mjData* d = with_hand ? loop.data() : copy.get();
-  long solver_iterations = 0;
-  for (auto _ : state) {
-    mj_step(m, d);
-    solver_iterations += d->solver_iter;
-  }
-  state.SetItemsProcessed(state.iterations());
-  // the constraint solver's iterations in the step's last evaluation
-  state.counters["solver_iter"] =
-      static_cast<double>(solver_iterations) /
-      static_cast<double>(state.iterations());
-  state.counters["time_s"] = d->time;
-}
-
-void BM_BareStep(benchmark::State& state) { step_model(state, false); }
-void BM_HandStep(benchmark::State& state) { step_model(state, true); }
-
-// The loop's own data stepped with the hand's callback replaced by one that
-// does nothing, so that qfrc_applied keeps the hand's last wrench: the state
-// BM_HandStep steps, without the hand's cost. Tells the hand's cost per
-// step (BM_HandStep - BM_HeldHandStep) from what stepping a held arm instead
-// of BM_BareStep's falling copy costs MuJoCo (BM_HeldHandStep - BM_BareStep).
-void noop_control(const mjModel*, mjData*) {}
-void BM_HeldHandStep(benchmark::State& state) {
-  ClosedLoop loop(case_scene(static_cast<int>(state.range(0))),
-                  setting(state.range(1)));
-  warm_loop(&loop);
-  const mjModel* m = loop.model();
-  mjData* d = loop.data();
-  mjfGeneric saved = mjcb_control;
-  mjcb_control = noop_control;
+  mjData* d = what == Stepped::kBare ? copy.get() : loop.data();
+  const mjfGeneric saved = mjcb_control;
+  if (what == Stepped::kHeldHand) mjcb_control = noop_control;
   long solver_iterations = 0;
   for (auto _ : state) {
     mj_step(m, d);
@@ -109,10 +97,17 @@ void BM_HeldHandStep(benchmark::State& state) {
   }
   mjcb_control = saved;
   state.SetItemsProcessed(state.iterations());
-  state.counters["solver_iter"] =
-      static_cast<double>(solver_iterations) /
-      static_cast<double>(state.iterations());
+  report_solver_iterations(state, solver_iterations);
   state.counters["time_s"] = d->time;
+}
+
+void BM_BareStep(benchmark::State& state) { step_model(state, Stepped::kBare); }
+void BM_HandStep(benchmark::State& state) { step_model(state, Stepped::kHand); }
+// Tells the hand's cost per step (BM_HandStep - BM_HeldHandStep) from what
+// stepping a held arm instead of BM_BareStep's falling copy costs MuJoCo
+// (BM_HeldHandStep - BM_BareStep).
+void BM_HeldHandStep(benchmark::State& state) {
+  step_model(state, Stepped::kHeldHand);
 }
 
 // BM_ReplayStep: bare mj_step (no control callback, no controller, no
@@ -170,9 +165,7 @@ void BM_ReplayStep(benchmark::State& state) {
     ++k;
   }
   state.SetItemsProcessed(physics_steps);
-  state.counters["solver_iter"] =
-      static_cast<double>(solver_iterations) /
-      static_cast<double>(state.iterations());
+  report_solver_iterations(state, solver_iterations);
 }
 
 void BM_ClosedLoopTick(benchmark::State& state) {
@@ -195,10 +188,8 @@ void BM_ClosedLoopTick(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * loop.substeps());
   state.counters["substeps"] = loop.substeps();
-  // as in step_model: the last evaluation of the tick's last step
-  state.counters["solver_iter"] =
-      static_cast<double>(solver_iterations) /
-      static_cast<double>(state.iterations());
+  // the last evaluation of the tick's last step
+  report_solver_iterations(state, solver_iterations);
 }
 
 void BM_RunAll(benchmark::State& state) {
