@@ -76,7 +76,8 @@ Vec6 weighted_residual(const VirtualMechanism& vm, const RmPose& rm,
 
 namespace {
 
-// Gauss-Newton over the M active (unlocked) joints, in fixed-size matrices:
+// Gauss-Newton over the M active (unlocked) joints, whose indices into theta
+// are active[0..M), in fixed-size matrices:
 // the tick calls it with M = 1 (circle), 3 (sphere) or 3 and 5 (surface,
 // held or sliding), and perf put Eigen's dynamic-size LDLT, its triangular
 // solves and the resizes at a fifth of the sphere's Gauss-Newton tick.
@@ -84,7 +85,7 @@ template <int M>
 PlacementResult gauss_newton_active(const VirtualMechanism& vm,
                                     const RmPose& rm,
                                     const PlacementOptions& options,
-                                    JointMask locked, VmAngles* theta,
+                                    const int* active, VmAngles* theta,
                                     const VmPose* pose_at_start,
                                     const VmJacobian* J_at_start) {
   using JacobianM = Eigen::Matrix<double, 6, M>;
@@ -93,12 +94,6 @@ PlacementResult gauss_newton_active(const VirtualMechanism& vm,
   PlacementResult result;
   const Vec6& w = options.weights;
   const auto W = w.asDiagonal();
-  const int dof = vm.dof();
-  // the active joints' indices into theta
-  int active[kMaxVmDof];
-  for (int j = 0, k = 0; j < dof; ++j) {
-    if ((locked & (JointMask{1} << j)) == 0) active[k++] = j;
-  }
   VmJacobian J;
   JacobianM Ja;
   SquareM A, A_damped;
@@ -223,25 +218,27 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
   // pivot, where the plain iteration diverges at rate |1 - d/L|, or a
   // surface probe stretched toward an RM it cannot reach) the damping grows
   // and the step turns toward steepest descent.
-  int active = 0;
+  // the active (unlocked) joints' indices into theta
+  int active[kMaxVmDof];
+  int m = 0;
   for (int j = 0; j < vm.dof(); ++j) {
-    if ((locked & (JointMask{1} << j)) == 0) ++active;
+    if ((locked & (JointMask{1} << j)) == 0) active[m++] = j;
   }
-  switch (active) {
+  switch (m) {
     case 1:
-      return gauss_newton_active<1>(vm, rm, options, locked, theta,
+      return gauss_newton_active<1>(vm, rm, options, active, theta,
                                     pose_at_start, J_at_start);
     case 2:
-      return gauss_newton_active<2>(vm, rm, options, locked, theta,
+      return gauss_newton_active<2>(vm, rm, options, active, theta,
                                     pose_at_start, J_at_start);
     case 3:
-      return gauss_newton_active<3>(vm, rm, options, locked, theta,
+      return gauss_newton_active<3>(vm, rm, options, active, theta,
                                     pose_at_start, J_at_start);
     case 4:
-      return gauss_newton_active<4>(vm, rm, options, locked, theta,
+      return gauss_newton_active<4>(vm, rm, options, active, theta,
                                     pose_at_start, J_at_start);
     case 5:
-      return gauss_newton_active<5>(vm, rm, options, locked, theta,
+      return gauss_newton_active<5>(vm, rm, options, active, theta,
                                     pose_at_start, J_at_start);
     default: {
       // every joint locked: nothing to move
