@@ -4,13 +4,13 @@
 //   BM_ServoTick        by servo_tick() alone, straight on the device;
 //   BM_SafetyServoTick  by servo_tick() through the reading guard and the
 //                       safety layer (device/safety.h);
-//   BM_HwLoopTick       by the hw session's loop (cli/hw_loop.h): the same
-//                       chain, plus the reference controller off, the
-//                       sample's bookkeeping and its push into the ring.
+//   BM_HwLoopTick       by the session's loop (runtime/session_loop.h): the
+//                       same chain (device/servo_chain.h), plus the
+//                       record's bookkeeping and its push into the ring.
 // The difference of the last two from the first is the hw path's own cost.
 #include <benchmark/benchmark.h>
 
-#include "cli/hw_loop.h"
+#include "runtime/session_loop.h"
 #include "controller/controller.h"
 #include "device/reading_guard.h"
 #include "device/safety.h"
@@ -65,12 +65,11 @@ BENCHMARK(BM_SafetyServoTick);
 
 void BM_HwLoopTick(benchmark::State& state) {
   FixedDevice dev;
-  cli::SessionOptions o;
-  o.mode = cli::HwMode::kRun;
-  o.duration_s = 1e30;
+  ChainOptions o;
+  o.mode = ChainMode::kRun;
   o.controller = circle();
-  cli::HwLoop loop(&dev, o, OmniParams(), nullptr);
-  cli::HwSample s;
+  runtime::SessionLoop loop(&dev, o, 1e-3, 1e30, nullptr);
+  TickRecord s;
   double t = 0.0;
   long n = 0;
   for (auto _ : state) {

@@ -26,8 +26,8 @@ void BM_Render(benchmark::State& state) {
   const int h = static_cast<int>(state.range(1));
   const bool encode = state.range(2) != 0;
   std::string name;
-  sim::ClosedLoop loop(studies::resolve_scene("case1", &name), {});
-  sim::TraceRow row;
+  sim::ClosedLoop loop(sim::resolve_scene("case1", &name), {});
+  TickRecord row;
   while (loop.time_s() < 2.5 - 1e-9) loop.tick(&row);
   std::vector<OverlayPrimitive> prims;
   overlay_primitives(loop.controller().mechanism(), loop.controller_params(),

@@ -45,7 +45,7 @@ namespace {
 
 std::string case_scene(int n) {
   std::string name;
-  return studies::resolve_scene("case" + std::to_string(n), &name);
+  return sim::resolve_scene("case" + std::to_string(n), &name);
 }
 
 std::vector<std::string> setting(int64_t which) {
@@ -56,7 +56,7 @@ std::vector<std::string> setting(int64_t which) {
 // a loop that has run for 0.2 s, so that the Omni is moving and the
 // controller is warm
 ClosedLoop& warm_loop(ClosedLoop* loop) {
-  TraceRow row;
+  TickRecord row;
   for (int i = 0; i < 200; ++i) loop->tick(&row);
   return *loop;
 }
@@ -132,7 +132,7 @@ void BM_ReplayStep(benchmark::State& state) {
     std::vector<mjtNum> qpos, qvel, warmstart, ctrl, wrench, time;
     std::vector<int> steps;
   } tape;
-  TraceRow row;
+  TickRecord row;
   for (int k = 0; k < ticks; ++k) {
     const mjData* d = loop.data();
     tape.qpos.insert(tape.qpos.end(), d->qpos, d->qpos + nq);
@@ -172,7 +172,7 @@ void BM_ClosedLoopTick(benchmark::State& state) {
   ClosedLoop loop(case_scene(static_cast<int>(state.range(0))),
                   setting(state.range(1)));
   warm_loop(&loop);
-  TraceRow row;
+  TickRecord row;
   long ticks = 0;
   long solver_iterations = 0;
   for (auto _ : state) {
@@ -196,7 +196,7 @@ void BM_RunAll(benchmark::State& state) {
   int claims_failed = 0;
   for (auto _ : state) {
     std::vector<studies::CaseJob> jobs;
-    for (const studies::CaseEntry& c : studies::thesis_cases()) {
+    for (const sim::CaseEntry& c : sim::thesis_cases()) {
       jobs.push_back(studies::CaseJob{c.name, case_scene(static_cast<int>(
                                          jobs.size() + 1)), {}, {}, false, false});
     }
@@ -209,7 +209,7 @@ void BM_RunAll(benchmark::State& state) {
       claims_failed += j.result.all_claims_pass ? 0 : 1;
     }
   }
-  state.counters["cases"] = static_cast<double>(studies::thesis_cases().size());
+  state.counters["cases"] = static_cast<double>(sim::thesis_cases().size());
   state.counters["claims_failed"] = claims_failed;
 }
 

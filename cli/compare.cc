@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "cli/args.h"
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 #include "report/output_file.h"
 #include "sim/mujoco_util.h"
 #include "studies/bringup/compare_check.h"

@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "cli/args.h"
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 #include "controller/controller.h"
 #include "controller/device_frame.h"
 #include "sim/case_params.h"

@@ -2,14 +2,13 @@
 
 #include <cmath>
 #include <cstdio>
-
-#include <csignal>
+#include <filesystem>
 
 #include "cli/args.h"
-#include "hw/firewire/firewire_omni.h"
-#include "report/output_file.h"
 
 namespace vmh::cli {
+
+namespace fs = std::filesystem;
 
 void check_seconds(const std::string& what, double v, double lo_s, double hi_s) {
   if (std::isfinite(v) && v > lo_s && v <= hi_s) return;
@@ -19,32 +18,30 @@ void check_seconds(const std::string& what, double v, double lo_s, double hi_s) 
 }
 
 void add_hw_common(CLI::App* cmd, HwCommon* c) {
+  const runtime::BackendRegistry& reg = runtime::BackendRegistry::global();
+  std::string devices;
+  for (const runtime::BackendInfo& b : reg.all()) {
+    if (!b.servo) continue;
+    devices += (devices.empty() ? "" : ", ") + b.grammar;
+  }
   cmd->add_option("--device", c->device,
-                  "emulator[:case|scene.xml] (default), "
-                  "emulator:firewire[:case|scene.xml] (the emulator behind the "
-                  "FireWire packets), openhaptics[:CONFIG_NAME] or "
-                  "firewire[:GUID]");
-  cmd->add_option("--hand", c->hand,
-                  "emulator: what holds the stylus: case, tour, none, dock, "
-                  "gimbal_sweep (default depends on the verb)");
-  cmd->add_option("--fault", c->faults,
-                  "emulator: transport faults, e.g. "
-                  "drop@1.0:5,late@2:0.5:3,stall@3:0.2,unplug@4:1; "
-                  "emulator:firewire: packet faults, e.g. loss@1:5,"
-                  "late@2:0.5:3,length@3:2,reset@4,unplug@5:1,stall@6:0.2");
-  cmd->add_option("--emulator-fault", c->seeded,
-                  "emulator: seeded faults for bring-up tests, comma-separated: "
-                  "joint<N>_sign, gimbal_swap, link_length_<P>pct, delay_<M>ms, "
-                  "motor3_relative, motor<N>_sign, torque_units_Nm, "
-                  "torque_units_mNm, mass_x<K>, friction_x<K>, damping_x<K> "
-                  "(docs/hardware.md)");
-  cmd->add_option("--model", c->model,
-                  "emulator: a calibrated Omni MJCF (e.g. "
-                  "models/omni/calibrated/<serial>.xml) whose parameters "
-                  "replace the scene's Omni's");
-  cmd->add_option("--hd-command", c->hd_command,
-                  "openhaptics: joint_torque (HD_CURRENT_JOINT_TORQUE, "
-                  "mN m; default) or force (HD_CURRENT_FORCE, N)");
+                  "the device: " + devices + " (default emulator; `vmhaptics "
+                  "hw list` shows what this machine has)");
+  for (const runtime::BackendRegistry::OptionUse& u : reg.option_uses()) {
+    const std::string key = u.key;
+    cmd->add_option_function<std::string>(
+           "--" + key,
+           [c, key](const std::string& v) { c->options[key] = v; },
+           u.backends + ": " + u.help)
+        ->type_name("TEXT");
+  }
+  cmd->add_option("--clock", c->clock,
+                  "realtime (the wall clock: a servo thread, as on a device) "
+                  "or lockstep (one period of simulated physics per tick, on "
+                  "one thread: deterministic, as fast as the machine allows; "
+                  "simulated devices only). Default: lockstep for a simulated "
+                  "device, realtime otherwise")
+      ->check(CLI::IsMember({"realtime", "lockstep"}));
   cmd->add_flag("--no-realtime", c->no_realtime,
                 "do not ask for SCHED_FIFO and mlockall");
   cmd->add_flag("--require-deadman", c->require_deadman,
@@ -54,168 +51,75 @@ void add_hw_common(CLI::App* cmd, HwCommon* c) {
   cmd->add_flag("--quiet", c->quiet, "no progress lines on stderr");
 }
 
-OpenedDevice open_hw_device(const HwCommon& c, const std::string& default_hand,
-                            const std::vector<std::string>& overrides) {
-  const DeviceSpec spec = parse_device_spec(c.device);
-  if (spec.backend != "emulator") {
-    // a real device has no seeded faults and no model to replace
-    if (!c.seeded.empty()) {
-      throw UsageError("--emulator-fault: only the emulator takes seeded "
-                       "faults, not --device " + c.device);
-    }
-    if (!c.model.empty()) {
-      throw UsageError("--model: only the emulator simulates a model, not "
-                       "--device " + c.device);
-    }
-  }
-  OpenOptions oo;
-  oo.overrides = overrides;
-  oo.seeded = c.seeded;
-  oo.model_file = c.model;
-  oo.hand = c.hand.empty() ? default_hand : c.hand;
-  oo.faults = c.faults;
-  oo.hd_command = c.hd_command;
-  oo.load_calibration = !c.no_calibration;
-  return open_device(spec, oo);
+const runtime::BackendInfo& hw_backend(const HwCommon& c, std::string* argument) {
+  return runtime::BackendRegistry::global().resolve(c.device, argument);
 }
 
-SessionOptions session_options(const HwCommon& c, const std::string& verb) {
-  SessionOptions o;
+bool hw_lockstep(const HwCommon& c) {
+  std::string argument;
+  const runtime::BackendInfo& b = hw_backend(c, &argument);
+  if (c.clock == "lockstep" && !b.simulated) {
+    throw UsageError("--clock lockstep: only a simulated device runs in "
+                     "lockstep, not --device " + c.device);
+  }
+  if (c.clock.empty()) return b.simulated;
+  return c.clock == "lockstep";
+}
+
+runtime::OpenedDevice open_hw_device(const HwCommon& c,
+                                     const std::string& default_hand,
+                                     const std::vector<std::string>& sets,
+                                     const std::string& argument) {
+  runtime::OpenRequest rq;
+  rq.options = c.options;
+  rq.defaults["hand"] = default_hand;
+  rq.scene_sets = sets;
+  rq.load_calibration = !c.no_calibration;
+  rq.lockstep = hw_lockstep(c);
+  std::string spec = c.device;
+  if (!argument.empty()) {
+    std::string given;
+    const runtime::BackendInfo& b = hw_backend(c, &given);
+    spec = b.name + ":" + argument;
+  }
+  return runtime::BackendRegistry::global().open(spec, rq);
+}
+
+runtime::SessionOptions session_options(const HwCommon& c, const std::string& verb) {
+  runtime::SessionOptions o;
   o.verb = "hw " + verb;
   o.servo.realtime = !c.no_realtime;
-  o.safety.require_deadman = c.require_deadman;
+  o.servo.lockstep = hw_lockstep(c);
+  o.chain.safety_params.require_deadman = c.require_deadman;
   o.progress = !c.quiet;
   return o;
 }
 
-Json identity_json(const DeviceIdentity& id) {
-  return Json{{"backend", id.backend},
-              {"config", id.config},
-              {"model", id.model},
-              {"vendor", id.vendor},
-              {"serial", id.serial},
-              {"driver_version", id.driver_version},
-              {"firmware_version", id.firmware_version},
-              {"api_version", id.api_version},
-              {"input_dof", id.input_dof},
-              {"output_dof", id.output_dof}};
+std::unique_ptr<report::OutputSet> hw_output_set(const std::string& verb,
+                                                 const std::string& out,
+                                                 bool given) {
+  if (!given) return nullptr;
+  if (out.empty()) {
+    throw UsageError("hw " + verb + ": --out: an empty name is not a folder");
+  }
+  std::error_code ec;
+  const fs::file_status st = fs::status(out, ec);
+  if (!ec && fs::exists(st) && !fs::is_directory(st)) {
+    throw UsageError("hw " + verb + ": --out '" + out +
+                     "' is not a folder (it is a file)");
+  }
+  try {
+    return std::make_unique<report::OutputSet>(out);
+  } catch (const std::runtime_error& e) {
+    throw UsageError("hw " + verb + ": --out '" + out + "': " + e.what());
+  }
 }
 
-Json timing_json(const TickStats& t) {
-  return Json{{"ticks", t.ticks},
-              {"overruns", t.overruns},
-              {"nominal_period_us", 1e6 * t.nominal_period_s},
-              {"period_mean_us", 1e6 * t.period_mean_s},
-              {"period_min_us", 1e6 * t.period_min_s},
-              {"period_p50_us", 1e6 * t.period_p50_s},
-              {"period_p99_us", 1e6 * t.period_p99_s},
-              {"period_max_us", 1e6 * t.period_max_s},
-              {"jitter_p50_us", 1e6 * t.jitter_p50_s},
-              {"jitter_p99_us", 1e6 * t.jitter_p99_s},
-              {"jitter_max_us", 1e6 * t.jitter_max_s},
-              {"work_p50_us", 1e6 * t.work_p50_s},
-              {"work_p99_us", 1e6 * t.work_p99_s},
-              {"work_max_us", 1e6 * t.work_max_s}};
-}
-
-Json session_json(const SessionResult& r) {
-  Json safety = Json::object();
-  for (const auto& [k, v] : r.safety_ticks) safety[k] = v;
-  Json errors = Json::object();
-  for (const auto& [k, v] : r.read_errors) errors[k] = v;
-  return Json{{"duration_s", r.duration_s},
-              {"ticks", r.ticks},
-              {"samples_dropped", r.dropped},
-              {"stop_reason", r.stop_reason},
-              {"zeroed_ticks", r.zeroed_ticks},
-              {"safety_ticks", safety},
-              {"read_errors", errors},
-              {"servo",
-               Json{{"sched_fifo", r.servo_report.sched_fifo},
-                    {"memory_locked", r.servo_report.memory_locked},
-                    {"note", r.servo_report.note}}},
-              {"timing", timing_json(r.timing)}};
-}
-
-Json meta_json(const OpenedDevice& dev, const SessionResult& r,
-               const std::string& verb, const Json& extra) {
-  Json m{{"verb", "hw " + verb},
-         {"software", Json{{"name", "vmhaptics"}, {"version", VMH_VERSION}}},
-         {"date_utc", utc_now()},
-         {"device", identity_json(dev.backend->identity())},
-         {"calibration",
-          Json{{"state", calibration_state_name(dev.backend->calibration_state())},
-               {"source", dev.calibration_source}}},
-         {"session", session_json(r)}};
-  // the periods' histogram, up to its last non-empty bin
-  Json counts = Json::array();
-  std::size_t last = 0;
-  for (std::size_t i = 0; i < r.timing.histogram.size(); ++i) {
-    if (r.timing.histogram[i] != 0) last = i + 1;
-  }
-  for (std::size_t i = 0; i < last; ++i) counts.push_back(r.timing.histogram[i]);
-  m["period_histogram"] = Json{{"bin_us", 1e6 * r.timing.histogram_bin_s},
-                               {"counts", counts},
-                               {"last_bin_holds_the_rest", true}};
-  if (dev.firewire != nullptr) {
-    // the bus and the packets: where the node was, what was lost
-    const hw::fw::NodeInfo n = dev.firewire->transport()->node();
-    const hw::fw::TransportStats t = dev.firewire->transport()->stats();
-    const hw::fw::FirewireOmniStats d = dev.firewire->omni()->stats();
-    m["firewire"] = Json{
-        {"node", Json{{"guid", n.guid},
-                      {"vendor", n.vendor},
-                      {"serial", n.serial},
-                      {"description", n.description},
-                      {"generation", n.generation}}},
-        {"transport", Json{{"received", t.received},
-                           {"sent", t.sent},
-                           {"bad_packets", t.bad_packets},
-                           {"timeouts", t.timeouts},
-                           {"bus_resets", t.bus_resets},
-                           {"recoveries", t.recoveries}}},
-        {"device", Json{{"packets", d.packets},
-                        {"lost_packets", d.lost_packets},
-                        {"bad_packets", d.bad_packets},
-                        {"timeouts", d.timeouts},
-                        {"bus_resets", d.bus_resets},
-                        {"recoveries_failed", d.recoveries_failed},
-                        {"commands", d.commands},
-                        {"saturated_commands", d.saturated_commands}}}};
-  }
-  if (dev.emulator != nullptr) {
-    // what compare needs to simulate the same scene; the seeded faults are
-    // the emulator's hidden setup, there for tests to grade compare by
-    m["emulator"] = Json{
-        {"scene", dev.scene},
-        {"hand", dev.hand},
-        {"model", dev.model_file.empty() ? Json(nullptr) : Json(dev.model_file)},
-        {"seeded_faults", dev.seeded_faults},
-        {"seeded_faults_note",
-         "the emulator's hidden setup, for tests only: an analysis must not "
-         "read it"}};
-  }
-  for (auto it = extra.begin(); it != extra.end(); ++it) m[it.key()] = it.value();
-  return m;
-}
-
-void write_meta(const std::string& out_dir, const Json& meta) {
-  if (out_dir.empty()) return;
-  report::write_file_in(out_dir, "meta.json", dump_readable(meta) + "\n");
-}
-
-void raise_if_cut_short(const SessionResult& r, const std::string& verb) {
-  if (r.signal != 0) {
-    throw SignalStop("hw " + verb + ": stopped by " + r.stop_reason.substr(7) +
-                         "; zero torque sent, trace kept up to t = " +
-                         std::to_string(r.duration_s) + " s",
-                     r.signal);
-  }
-  if (r.device_gone) {
-    throw std::runtime_error("hw " + verb + ": " + r.stop_reason +
-                             "; zero torque sent, trace kept up to t = " +
-                             std::to_string(r.duration_s) + " s");
-  }
+void trace_into(report::OutputSet* set, const std::string& out,
+                runtime::SessionOptions* so) {
+  if (set == nullptr) return;
+  so->trace_path = (fs::path(set->temp_dir()) / "trace.csv").string();
+  so->trace_shown = (fs::path(out) / "trace.csv").string();
 }
 
 }  // namespace vmh::cli

@@ -1,26 +1,31 @@
-// What the `hw` verbs share: the options every one of them takes, opening
-// the device they name, and the metadata every recording carries.
+// What the `hw` verbs share: the options every one of them takes (the
+// backends' own options come from the registry: a --KEY flag for each key
+// some backend takes), the clock, opening the device they name, and the
+// output set every recording is written as.
 #ifndef VMHAPTICS_CLI_HW_COMMON_H_
 #define VMHAPTICS_CLI_HW_COMMON_H_
 
 #include <CLI/CLI.hpp>
 
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "cli/hw_backends.h"
-#include "cli/hw_session.h"
-#include "cli/json_util.h"
+#include "report/output_file.h"
+#include "runtime/backend_registry.h"
+#include "runtime/json_util.h"
+#include "runtime/session.h"
 
 namespace vmh::cli {
 
 struct HwCommon {
   std::string device = "emulator";
-  std::string hand;        // emulator: who holds the stylus (verb default)
-  std::string faults;      // emulator: injected transport faults
-  std::string seeded;      // emulator: seeded faults (--emulator-fault)
-  std::string model;       // emulator: a calibrated Omni MJCF (--model)
-  std::string hd_command = "joint_torque";
+  // the backends' options by key, as given (--hand, --fault, ...)
+  std::map<std::string, std::string> options;
+  // "realtime", "lockstep" or "" (the verb's default: lockstep for a
+  // simulated device, the wall clock for a real one)
+  std::string clock;
   bool no_realtime = false;
   bool require_deadman = false;
   bool no_calibration = false;
@@ -32,44 +37,42 @@ struct HwCommon {
 // verb and the option ("hw record: --duration").
 void check_seconds(const std::string& what, double v, double lo_s, double hi_s);
 
-// Adds --device, --hand, --fault, --emulator-fault, --model, --hd-command,
+// Adds --device, a flag per registered backend option, --clock,
 // --no-realtime, --require-deadman, --no-calibration and --quiet to a verb.
 void add_hw_common(CLI::App* cmd, HwCommon* c);
 
-// Opens the device named by c.device (UsageError for an unknown backend,
-// for --emulator-fault or --model with another backend than the emulator,
-// for a bad fault name or model file; DeviceOpenError for a device that
-// cannot be opened).
-OpenedDevice open_hw_device(const HwCommon& c, const std::string& default_hand,
-                            const std::vector<std::string>& overrides = {});
+// The backend c.device names and its argument (UsageError when none).
+const runtime::BackendInfo& hw_backend(const HwCommon& c, std::string* argument);
+// Whether the verb runs in lockstep: --clock, else lockstep exactly when
+// the backend is simulated. UsageError for lockstep on a real device.
+bool hw_lockstep(const HwCommon& c);
 
-// Session options from the common flags
-SessionOptions session_options(const HwCommon& c, const std::string& verb);
+// Opens the device named by c.device for a servo loop (RequestError for an
+// unknown backend or an option it does not take; DeviceOpenError for a
+// device that cannot be opened). `default_hand`: the hand program a
+// simulated device plays unless --hand says otherwise. `argument`, when
+// not empty, replaces the spec's (hw run's scene). `sets`: the scene's
+// --set overrides.
+runtime::OpenedDevice open_hw_device(const HwCommon& c,
+                                     const std::string& default_hand,
+                                     const std::vector<std::string>& sets = {},
+                                     const std::string& argument = "");
 
-// identity, calibration, software version and date, the servo thread's
-// report and timing, the stop reason: what meta.json holds; on the
-// emulator also "emulator": its scene (absolute path), hand program, model
-// file (or null) and, as the emulator's hidden setup for tests,
-// "seeded_faults"; on firewire and emulator:firewire also "firewire": the
-// node, the transport's and the device's packet counts
-Json identity_json(const DeviceIdentity& id);
-Json timing_json(const TickStats& t);
-Json session_json(const SessionResult& r);
-Json meta_json(const OpenedDevice& dev, const SessionResult& r,
-               const std::string& verb, const Json& extra);
+// Session options from the common flags: the verb's name, the clock, the
+// scheduling, the dead-man, progress.
+runtime::SessionOptions session_options(const HwCommon& c, const std::string& verb);
 
-// Writes out_dir/meta.json (atomically); nothing when out_dir is empty
-void write_meta(const std::string& out_dir, const Json& meta);
-
-// The session's end as an error, when it did not end as asked: a device
-// that stopped answering (std::runtime_error, exit 1) or a signal
-// (SignalStop, exit 130 / 143). Call after the outputs are written.
-struct SignalStop : std::runtime_error {
-  SignalStop(const std::string& what, int signo)
-      : std::runtime_error(what), signal(signo) {}
-  int signal;
-};
-void raise_if_cut_short(const SessionResult& r, const std::string& verb);
+// The output set of a recording verb (--out DIR): created before the
+// device is opened, so that an unusable DIR (a file, /proc, an empty
+// name) is a usage error (exit 2) with nothing opened or written. Null
+// when `out` was not given. trace.csv goes into its private folder as the
+// session runs; commit() puts trace, meta and summary in place together.
+std::unique_ptr<report::OutputSet> hw_output_set(const std::string& verb,
+                                                 const std::string& out,
+                                                 bool given);
+// the session's trace path in the set and the path it will have
+void trace_into(report::OutputSet* set, const std::string& out,
+                runtime::SessionOptions* so);
 
 }  // namespace vmh::cli
 

@@ -20,7 +20,7 @@
 
 #include "cli/args.h"
 #include "cli/hw.h"
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 #include "hw/firewire/omni_packet.h"
 
 namespace vmh::cli {

@@ -22,8 +22,8 @@
 #include <vector>
 
 #include "cli/args.h"
-#include "cli/hw_common.h"
-#include "cli/json_util.h"
+#include "runtime/session.h"
+#include "runtime/json_util.h"
 #include "report/output_file.h"
 #include "report/svg_chart.h"
 #include "studies/bringup/identify.h"
@@ -137,7 +137,7 @@ void identify_verb(const IdentifyCliOptions& o) {
   bringup::IdentifyOptions io;
   io.fit = split_names(o.fit);
   // a real device's recording names no scene: the emulator's default one
-  io.default_scene = studies::models_dir() + "/cases/case1.xml";
+  io.default_scene = sim::models_dir() + "/cases/case1.xml";
   std::vector<bringup::Recording> recs;
   for (const std::string& d : o.dirs) {
     if (!std::filesystem::is_directory(d)) {
@@ -158,7 +158,7 @@ void identify_verb(const IdentifyCliOptions& o) {
 
   const std::string serial = o.serial.empty() ? serial_of(recs) : o.serial;
   const std::string model = o.model_out.empty()
-                                ? studies::models_dir() + "/omni/calibrated/" + serial + ".xml"
+                                ? sim::models_dir() + "/omni/calibrated/" + serial + ".xml"
                                 : o.model_out;
   std::ostringstream prov;
   prov << "calibrated by vmhaptics identify: serial " << serial << ", " << utc_now()
@@ -172,7 +172,7 @@ void identify_verb(const IdentifyCliOptions& o) {
   prov << "; edit " << sim::omni_edit_text(r.edit) << "; " << r.conditioning;
   const std::filesystem::path model_dir = std::filesystem::path(model).parent_path();
   if (!model_dir.empty()) std::filesystem::create_directories(model_dir);
-  bringup::write_calibrated_model(r.edit, studies::models_dir() + "/omni/omni.xml", model, prov.str());
+  bringup::write_calibrated_model(r.edit, sim::models_dir() + "/omni/omni.xml", model, prov.str());
 
   Json out;
   out["serial"] = serial;

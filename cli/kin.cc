@@ -10,7 +10,7 @@
 #include <string>
 
 #include "cli/args.h"
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "controller/omni_params.h"

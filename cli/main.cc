@@ -24,17 +24,23 @@
 #include <iostream>
 
 #include "cli/args.h"
+#include "cli/hw.h"
+#include "cli/kin.h"
+#include "hw/backends.h"
+#include "runtime/backend_registry.h"
+#include "runtime/session.h"
+#ifdef VMH_HAVE_SIM
 #include "cli/compare.h"
 #include "cli/ctl.h"
-#include "cli/hw.h"
-#include "cli/hw_common.h"
-#include "cli/kin.h"
 #include "cli/params.h"
 #include "cli/run.h"
 #include "cli/study.h"
+#include "sim/emulator_backend.h"
 #include "sim/mujoco_messages.h"
+#endif
 
 namespace vmh::cli {
+#ifdef VMH_HAVE_SIM
 // cli/identify.cc: fit the Omni model to recordings
 void register_identify(CLI::App* app);
 // cli/report.cc: the HTML report of the cases and the studies
@@ -44,6 +50,7 @@ void register_report(CLI::App* app);
 void register_render(CLI::App* app);
 // cli/view.cc: the interactive viewer
 void register_view(CLI::App* app);
+#endif
 #endif
 }  // namespace vmh::cli
 
@@ -79,10 +86,12 @@ void check_verbs(CLI::App* app, int argc, char** argv) {
 
 // MuJoCo's warnings of the whole run, one line per kind, on stderr
 void print_mujoco_warnings() {
+#ifdef VMH_HAVE_SIM
   for (const std::string& line :
        vmh::sim::mujoco_warning_lines(vmh::sim::mujoco_warnings_so_far())) {
     std::cerr << "vmhaptics: warning: " << line << '\n';
   }
+#endif
 }
 
 // control characters (an ANSI escape in an argument the message quotes) as
@@ -114,24 +123,34 @@ int fail(int code, const std::string& message, const char* prefix = "error: ") {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // the device backends, before the verbs that offer their options
+  vmh::runtime::BackendRegistry& backends = vmh::runtime::BackendRegistry::global();
+  vmh::hw::register_backends(&backends);
+#ifdef VMH_HAVE_SIM
   vmh::sim::install_mujoco_handlers();
+  vmh::sim::register_backends(&backends);
+#endif
   CLI::App app{
       "vmhaptics: virtual-mechanism control of under-actuated haptic devices "
       "(PHANTOM Omni), after Wickham 2010 and Beckman & Luecke 2008"};
   app.set_version_flag("--version", std::string(VMH_VERSION));
   app.require_subcommand(1);
   vmh::cli::register_kin(&app);
+#ifdef VMH_HAVE_SIM
   vmh::cli::register_ctl(&app);
   vmh::cli::register_run(&app);
   vmh::cli::register_study(&app);
   vmh::cli::register_params(&app);
+#endif
   vmh::cli::register_hw(&app);
+#ifdef VMH_HAVE_SIM
   vmh::cli::register_compare(&app);
   vmh::cli::register_identify(&app);
   vmh::cli::register_report(&app);
 #ifdef VMH_HAVE_VIZ
   vmh::cli::register_render(&app);
   vmh::cli::register_view(&app);
+#endif
 #endif
 
   // CLI11 reads an empty value of a numeric option as 0: refuse it instead
@@ -150,9 +169,11 @@ int main(int argc, char** argv) {
     return fail(2, e.what());
   } catch (const vmh::cli::UsageError& e) {
     return fail(2, e.what());
+  } catch (const vmh::runtime::RequestError& e) {
+    return fail(2, e.what());
   } catch (const vmh::DeviceOpenError& e) {
     return fail(2, e.what());
-  } catch (const vmh::cli::SignalStop& e) {
+  } catch (const vmh::runtime::SignalStop& e) {
     return fail(128 + e.signal, e.what(), "");
   } catch (const std::exception& e) {
     return fail(1, e.what());

@@ -13,7 +13,7 @@
 #include <iostream>
 
 #include "cli/args.h"
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 #include "sim/mujoco_util.h"
 #include "studies/run_case.h"
 #include "viz/render.h"
@@ -56,7 +56,7 @@ void render_verb(const RenderOptions& o) {
   viz::RenderRequest req;
   req.times_s = parse_times(o.times);
   try {
-    req.scene_path = studies::resolve_scene(o.target, &req.name);
+    req.scene_path = sim::resolve_scene(o.target, &req.name);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("render: ") + e.what());
   }

@@ -22,7 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/args.h"
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 #include "report/output_file.h"
 #include "report/parallel.h"
 #include "report/progress.h"
@@ -132,7 +132,7 @@ std::string command_line(const ReportCli& o) {
 studies::PrecisionOptions precision_options(const ReportCli& o,
                                             const fs::path& study_dir) {
   studies::PrecisionOptions p;
-  p.scene = studies::resolve_scene("case1", &p.name);
+  p.scene = sim::resolve_scene("case1", &p.name);
   if (o.quick) {
     p.duration_s = kQuickPrecisionDuration_s;
     p.steps_s = {1e-3, 2e-4, 5e-5};
@@ -149,7 +149,7 @@ studies::StabilityOptions map_options(const ReportCli& o,
                                       const fs::path& study_dir, int jobs) {
   const MapSetting m = o.quick ? kMapQuick : kMapFull;
   studies::StabilityOptions so;
-  so.model_path = studies::slider_model_path(studies::models_dir());
+  so.model_path = studies::slider_model_path(sim::models_dir());
   so.params.mass_kg = 0.08;
   so.params.damping_Ns_per_m = 0.028;
   so.params.servo_period_s = 1e-3;
@@ -191,13 +191,13 @@ void run(const ReportCli& o) {
   // what is there already (with --reuse) and what must run
   std::vector<std::string> reused, ran;
   std::vector<studies::CaseJob> cases;
-  for (const studies::CaseEntry& c : studies::thesis_cases()) {
+  for (const sim::CaseEntry& c : sim::thesis_cases()) {
     if (o.reuse && all_exist(dir / c.name, {"summary.json", "trace.csv",
                                             "views.svg", "history.svg"})) {
       reused.push_back(c.name);
     } else {
       std::string name;
-      cases.push_back({c.name, studies::resolve_scene(c.name, &name), {}, {}, false});
+      cases.push_back({c.name, sim::resolve_scene(c.name, &name), {}, {}, false});
       ran.push_back(c.name);
     }
   }
@@ -261,7 +261,7 @@ void run(const ReportCli& o) {
     return std::optional<std::string>();
   };
 #endif
-  for (const studies::CaseEntry& c : studies::thesis_cases()) {
+  for (const sim::CaseEntry& c : sim::thesis_cases()) {
     in.cases.push_back(studies::load_report_case(dir.string(), c.name, render));
   }
   studies::ReportStudies& st = in.studies;

@@ -21,7 +21,7 @@
 #include <iostream>
 
 #include "cli/args.h"
-#include "cli/hw_common.h"
+#include "runtime/session.h"
 #include "device/stop_signal.h"
 #include "report/output_file.h"
 #include "report/progress.h"
@@ -104,13 +104,13 @@ void run(const RunOptions& o) {
   std::vector<std::pair<std::string, std::string>> jobs;
   try {
     if (o.all) {
-      for (const studies::CaseEntry& c : studies::thesis_cases()) {
+      for (const sim::CaseEntry& c : sim::thesis_cases()) {
         std::string name;
-        jobs.emplace_back(c.name, studies::resolve_scene(c.name, &name));
+        jobs.emplace_back(c.name, sim::resolve_scene(c.name, &name));
       }
     } else {
       std::string name;
-      const std::string scene = studies::resolve_scene(o.target, &name);
+      const std::string scene = sim::resolve_scene(o.target, &name);
       jobs.emplace_back(name, scene);
     }
   } catch (const sim::SimError& e) {
@@ -155,7 +155,7 @@ void run(const RunOptions& o) {
       for (const studies::CaseJob& j : runs) {
         if (j.error.empty() && !o.out.empty()) kept += " " + j.name;
       }
-      throw SignalStop(std::string("interrupted: run stopped by ") +
+      throw runtime::SignalStop(std::string("interrupted: run stopped by ") +
                            (signo == SIGINT ? "SIGINT" : "SIGTERM") +
                            (o.out.empty() ? ""
                             : kept.empty() ? "; no set written"

@@ -13,7 +13,7 @@ std::string study_scene(const std::string& option, const std::string& value,
     target = "case" + value;
   }
   try {
-    return studies::resolve_scene(target, name);
+    return sim::resolve_scene(target, name);
   } catch (const sim::SimError& e) {
     throw UsageError(option + ": " + e.what());
   }

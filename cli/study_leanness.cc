@@ -10,7 +10,7 @@
 #include <memory>
 
 #include "cli/args.h"
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 #include "cli/study.h"
 #include "cli/study_files.h"
 #include "studies/leanness_study.h"
@@ -31,7 +31,7 @@ struct LeannessCli {
 void run(const LeannessCli& o) {
   studies::LeannessOptions p;
   if (o.cases.empty()) {
-    for (const studies::CaseEntry& c : studies::thesis_cases()) {
+    for (const sim::CaseEntry& c : sim::thesis_cases()) {
       std::string name;
       const std::string scene = study_scene("--case", c.name, &name);
       p.scenes.emplace_back(name, scene);

@@ -17,7 +17,7 @@
 #include <memory>
 
 #include "cli/args.h"
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 #include "cli/study.h"
 #include "cli/study_files.h"
 #include "report/progress.h"

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "cli/args.h"
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 #include "cli/study.h"
 #include "cli/study_files.h"
 #include "report/parallel.h"
@@ -86,7 +86,7 @@ std::vector<std::string> case_names(const std::vector<std::string>& given) {
   }
   std::vector<std::string> out;
   if (items.empty()) {
-    for (const auto& c : studies::thesis_cases()) out.push_back(c.name);
+    for (const auto& c : sim::thesis_cases()) out.push_back(c.name);
     return out;
   }
   for (const std::string& item : items) {
@@ -95,7 +95,7 @@ std::vector<std::string> case_names(const std::vector<std::string>& given) {
     // a thesis case by its name, so that the plan names it the same way
     // whichever spelling was given; a scene file by its path
     bool known = false;
-    for (const auto& c : studies::thesis_cases()) known |= name == c.name;
+    for (const auto& c : sim::thesis_cases()) known |= name == c.name;
     out.push_back(known ? name : scene);
   }
   return out;

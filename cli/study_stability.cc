@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "cli/args.h"
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 #include "cli/study.h"
 #include "report/parallel.h"
 #include "report/progress.h"
@@ -117,7 +117,7 @@ void run_study(const studies::StabilityOptions& p,
 
 void run_single(const StabilityCli& o, const studies::StabilityParams& p) {
   studies::StabilityOptions so;
-  so.model_path = studies::slider_model_path(studies::models_dir());
+  so.model_path = studies::slider_model_path(sim::models_dir());
   so.params = p;
   so.rel_tol = o.tolerance;
   so.out_dir = o.out;
@@ -147,7 +147,7 @@ void run_map(const StabilityCli& o, const studies::StabilityParams& base) {
                      number_text(o.map_b_max_Ns_per_m) + ")");
   }
   studies::StabilityOptions so;
-  so.model_path = studies::slider_model_path(studies::models_dir());
+  so.model_path = studies::slider_model_path(sim::models_dir());
   so.params = base;
   so.rel_tol = o.tolerance;
   so.jobs = o.jobs > 0 ? o.jobs : report::core_count();

@@ -13,8 +13,9 @@
 #include <memory>
 
 #include "cli/args.h"
-#include "cli/hw_backends.h"
-#include "cli/hw_loop.h"
+#include "runtime/backend_registry.h"
+#include "runtime/session.h"
+#include "runtime/trace_writer.h"
 #include "controller/device_frame.h"
 #include "sim/closed_loop.h"
 #include "studies/run_case.h"
@@ -35,27 +36,26 @@ struct ViewOptions {
   int height_px = 800;
 };
 
-// the device's servo loop running the case's controller, watched by the
-// viewer through HwLoop::latest() (a Seqlock: the loop never waits)
+// the device's servo loop running the case's controller on the wall clock
+// (a person watches), watched by the viewer through the session's latest
+// record (a Seqlock: the loop never waits)
 struct LiveDevice {
-  OpenedDevice dev;
-  SessionOptions session;
-  std::unique_ptr<HwLoop> loop;
+  runtime::OpenedDevice dev;
+  std::unique_ptr<runtime::LiveSession> session;
   ~LiveDevice() {
-    if (dev.backend) dev.backend->stop();  // zero torque at the device
+    if (session) session->stop();  // zero torque at the device
   }
 };
 
 std::unique_ptr<LiveDevice> open_live(const ViewOptions& o,
                                       const std::string& scene,
                                       viz::ViewerOptions* vo) {
-  DeviceSpec spec = parse_device_spec(o.device);
-  if (spec.backend == "emulator") {
-    if (!spec.argument.empty()) {
-      throw UsageError("view: the emulator plays the viewed scene; give it "
-                       "as the target, not in --device (" + o.device + ")");
-    }
-    spec.argument = scene;
+  const runtime::BackendRegistry& reg = runtime::BackendRegistry::global();
+  std::string argument;
+  const runtime::BackendInfo& backend = reg.resolve(o.device, &argument);
+  if (backend.simulated && !argument.empty()) {
+    throw UsageError("view: the emulator plays the viewed scene; give it "
+                     "as the target, not in --device (" + o.device + ")");
   }
   // the case's controller, as hw run builds it
   ControllerParams params;
@@ -65,30 +65,30 @@ std::unique_ptr<LiveDevice> open_live(const ViewOptions& o,
     throw UsageError(std::string("view: ") + e.what());
   }
   auto live = std::make_unique<LiveDevice>();
-  OpenOptions oo;
-  oo.overrides = o.sets;
-  oo.hand = "case";
-  live->dev = open_device(spec, oo);
-  SessionOptions& so = live->session;
-  so.mode = HwMode::kRun;
-  so.duration_s = 1e9;  // until the window closes
-  so.controller = params;
-  so.servo.period_s = params.servo_period_s;
-  so.servo.realtime = false;
-  so.safety.servo_period_s = params.servo_period_s;
-  so.guard.max_period_s = 4.0 * params.servo_period_s;
-  live->loop = std::make_unique<HwLoop>(live->dev.backend->device(), so,
-                                        params.omni, live->dev.emulator);
-  live->dev.backend->start(live->loop.get(), so.servo);
-  HwLoop* loop = live->loop.get();
-  vo->live = [loop] {
-    const HwSample s = loop->latest();
+  runtime::OpenRequest rq;
+  rq.defaults["hand"] = "case";
+  rq.scene_sets = o.sets;
+  live->dev = reg.open(backend.simulated ? backend.name + ":" + scene : o.device,
+                       rq);
+  ChainOptions chain;
+  chain.mode = ChainMode::kRun;
+  chain.controller = params;
+  chain.safety_params = safety_params_for(params);
+  chain.guard.max_period_s = 4.0 * params.servo_period_s;
+  ServoOptions servo;
+  servo.period_s = params.servo_period_s;
+  servo.realtime = false;
+  live->session =
+      std::make_unique<runtime::LiveSession>(&live->dev, chain, servo);
+  runtime::LiveSession* session = live->session.get();
+  vo->live = [session] {
+    const TickRecord s = session->latest();
     viz::LiveSample out;
-    out.valid = loop->ticks() > 0 && s.state.present != 0;
+    out.valid = session->ticks() > 0 && s.state.present != 0;
     out.t_s = s.t_s;
     out.q_device_rad = s.state.q_device_rad;
     out.out = s.out;
-    out.status = "safety " + safety_flags_text(s.safety);
+    out.status = "safety " + runtime::safety_flags_text(s.safety);
     return out;
   };
   vo->live_name = o.device;
@@ -104,14 +104,14 @@ void view(const ViewOptions& o) {
   std::string name;
   std::string scene;
   try {
-    scene = studies::resolve_scene(o.target, &name);
+    scene = sim::resolve_scene(o.target, &name);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("view: ") + e.what());
   }
   // the thesis cases to step through with [ and ]; a scene file alone
-  for (const studies::CaseEntry& c : studies::thesis_cases()) {
+  for (const sim::CaseEntry& c : sim::thesis_cases()) {
     std::string n;
-    vo.cases.push_back({c.name, studies::resolve_scene(c.name, &n)});
+    vo.cases.push_back({c.name, sim::resolve_scene(c.name, &n)});
     if (n == name) vo.case_index = static_cast<int>(vo.cases.size()) - 1;
   }
   if (vo.cases[static_cast<std::size_t>(vo.case_index)].name != name) {

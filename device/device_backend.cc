@@ -1,5 +1,9 @@
 #include "device/device_backend.h"
 
+#include <chrono>
+#include <cmath>
+#include <thread>
+
 namespace vmh {
 
 const char* calibration_state_name(CalibrationState s) {
@@ -10,6 +14,16 @@ const char* calibration_state_name(CalibrationState s) {
     case CalibrationState::kNeedsManualInput: return "needs_manual_input";
   }
   return "unknown";
+}
+
+void DeviceBackend::pass(double dt_s) {
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) return;
+  std::this_thread::sleep_for(std::chrono::duration<double>(dt_s));
+}
+
+CalibrationState DeviceBackend::update_calibration() {
+  throw DeviceOpenError(identity().backend +
+                        ": the device has no calibration routine of its own");
 }
 
 }  // namespace vmh

@@ -51,7 +51,18 @@ struct ServoOptions {
   double period_s = 1e-3;     // nominal servo period (1 kHz)
   bool realtime = true;       // ask for SCHED_FIFO and mlockall
   int priority = 80;          // SCHED_FIFO priority when granted
+  // the loop's clock: false, the wall clock (a servo thread, or the
+  // vendor's scheduler, ticks every period while the caller's thread
+  // waits in pass()); true, lockstep (device/lockstep.h: the ticks run in
+  // pass(), on the caller's thread, each followed by one period of the
+  // simulated plant). Only a simulated plant can run in lockstep.
+  bool lockstep = false;
 };
+
+// "realtime" or "lockstep", as meta.json and the timing report name them
+inline const char* servo_clock_name(const ServoOptions& o) {
+  return o.lockstep ? "lockstep" : "realtime";
+}
 
 // How the driver got on with the operating system, for the run's metadata.
 struct ServoReport {
@@ -72,8 +83,24 @@ class DeviceBackend {
   virtual HapticDevice* device() noexcept = 0;
 
   // Calls loop->tick() every options.period_s until stop() or the loop
-  // returns false. Throws DeviceOpenError if the loop cannot be started.
+  // returns false. Throws DeviceOpenError if the loop cannot be started
+  // (options.lockstep on a backend that is not simulated included).
   virtual ServoReport start(ServoLoop* loop, const ServoOptions& options) = 0;
+  // Lets dt_s of the loop's time pass. On the wall clock (the default) the
+  // calling thread sleeps dt_s while the servo thread ticks; in lockstep
+  // the backend runs those ticks now, on the calling thread.
+  virtual void pass(double dt_s);
+  // Why the device stopped answering, when the backend knows it is its own
+  // doing rather than the device's (the emulator's physics thread starved
+  // by a busy host); empty otherwise.
+  virtual std::string stall_cause() const { return {}; }
+  // The device's own calibration routine (OpenHaptics's
+  // hdUpdateCalibration); false where the host calibrates from raw
+  // readings instead (runtime/calibration.h)
+  virtual bool has_driver_calibration() const { return false; }
+  // Runs it and returns the state after; throws DeviceOpenError where
+  // there is none or it failed.
+  virtual CalibrationState update_calibration();
   // Ends the loop (waits for a running tick), then leaves zero torque.
   virtual void stop() noexcept = 0;
   // true while the loop runs (false once it returned false or stop() ran)

@@ -28,6 +28,14 @@ inline constexpr int kEncoderCountsPerRev = 15000;
 // direction each encoder counts in, relative to the device angle (§9.2)
 inline constexpr std::array<int, 3> kEncoderSign = {-1, +1, +1};
 
+// The inkwell (dock) pose, device convention, rad: an ESTIMATE. t1..t3 put
+// the wrist centre at OpenHaptics's inkwell position (0, -65.5, -88.1) mm
+// (docs/omni.md), t5 tilts the stylus 36 deg below horizontal, tip forward;
+// nobody has measured it on a device. Within the ranges of docs/sources.md
+// §5 (OmniParams).
+inline constexpr double kInkwellDevice_rad[6] = {0.0,  -0.647, -0.477,
+                                                 0.0,  1.0,    0.0};
+
 using EncoderCounts = std::array<std::int32_t, 3>;  // motors t1..t3
 using PotCodes = std::array<std::int32_t, 3>;       // gimbal t4..t6
 

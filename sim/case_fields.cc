@@ -396,6 +396,16 @@ const std::vector<ParamSpec>& case_fields() {
                 p->sim.fault_at_s = item(v);
               })
           .non_negative(),
+      numeric("sim", "safety_layer", 1, "0", "-",
+              "1: the simulated loop runs behind the device's safety layer "
+              "with the limits hw run uses (force ramp, force, torque and "
+              "impulse clamps, velocity and thermal cuts; docs/safety.md); "
+              "0: no limits beyond the controller's own saturation, as in "
+              "the thesis",
+              [](CaseParams* p, const ParamValue& v) {
+                p->sim.safety_layer = flag(v);
+              })
+          .flag01(),
       numeric("sim", "sensor_guard", 1, "1", "-",
               "1: the device layer refuses non-finite readings and latches on "
               "an encoder step faster than guard_max_speed_rad_s "

@@ -86,6 +86,7 @@ struct SimSettings {
   SensorFaultKind fault{};
   int fault_joint{};  // 1..6
   double fault_at_s{};
+  bool safety_layer{};  // the loop behind device/safety.h's SafetyLayer
   bool sensor_guard{};
   double guard_max_speed_rad_s{};
   bool gimbal_limits{};

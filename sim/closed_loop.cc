@@ -195,7 +195,6 @@ void ClosedLoop::build_controller() {
   }
   try {
     params_.validate();
-    controller_ = std::make_unique<Controller>(params_);
   } catch (const std::invalid_argument& e) {
     throw SimError(path_ + ": " + e.what());
   }
@@ -212,11 +211,19 @@ void ClosedLoop::build_device_chain() {
   fault.at_s = sim.fault_at_s;
   fault.jump_rad = kJumpCounts * 2.0 * kPi / params_.omni.encoder_counts_per_rev;
   injector_ = std::make_unique<FaultInjector>(device_.get(), fault);
-  GuardParams guard;
-  guard.enabled = sim.sensor_guard;
-  guard.max_speed_rad_s = sim.guard_max_speed_rad_s;
-  guard.max_period_s = jitter_hi_ * model_->opt.timestep;
-  guard_ = std::make_unique<ReadingGuard>(injector_.get(), guard);
+  ChainOptions chain;
+  chain.mode = ChainMode::kRun;
+  chain.guard.enabled = sim.sensor_guard;
+  chain.guard.max_speed_rad_s = sim.guard_max_speed_rad_s;
+  chain.guard.max_period_s = jitter_hi_ * model_->opt.timestep;
+  chain.controller = params_;
+  chain.safety = sim.safety_layer;
+  chain.safety_params = safety_params_for(params_);
+  try {
+    chain_ = std::make_unique<ServoChain>(injector_.get(), chain);
+  } catch (const std::invalid_argument& e) {
+    throw SimError(path_ + ": " + e.what());
+  }
 }
 
 Joints ClosedLoop::start_pose() {
@@ -251,7 +258,7 @@ Joints ClosedLoop::start_pose() {
 ClosedLoop::~ClosedLoop() = default;
 
 void ClosedLoop::set_reference(const ControllerParams& params) {
-  reference_ = std::make_unique<Controller>(params);
+  chain_->set_reference(params);
 }
 
 double ClosedLoop::time_s() const {
@@ -287,7 +294,7 @@ void ClosedLoop::reset() {
   mj_resetData(m, d);
   device_->reset();
   injector_->reset();
-  guard_->reset();
+  chain_->reset();
   tick_count_ = 0;
   substep_count_ = 0;
   rng_state_ = jitter_seed_;
@@ -297,8 +304,6 @@ void ClosedLoop::reset() {
   warning_counts_.fill(0);
   warning_seen_.fill(0);
   physics_fault_.reset();
-  controller_->reset();
-  if (reference_) reference_->reset();
   // write the start angles through the joint addresses
   for (int i = 0; i < 6; ++i) {
     const std::string name = "q" + std::to_string(i + 1);
@@ -383,17 +388,16 @@ ScriptPose ClosedLoop::script_target(double t_s) {
 // the mechanism works in the controller's length unit
 double ClosedLoop::distance_to_path_mm(const Vec3& p_mm) const {
   const double u = params_.length_unit_mm;
-  return controller_->mechanism().distance_to_path(p_mm / u) * u;
+  return controller().mechanism().distance_to_path(p_mm / u) * u;
 }
 
 Vec3 ClosedLoop::nearest_on_path_mm(const Vec3& p_mm) const {
   const double u = params_.length_unit_mm;
-  return controller_->mechanism().nearest_on_path(p_mm / u) * u;
+  return controller().mechanism().nearest_on_path(p_mm / u) * u;
 }
 
-void ClosedLoop::tick(TraceRow* row) {
+void ClosedLoop::tick(TickRecord* row) {
   const double t = time_s();
-  row->t_s = t;
   const double t_script = std::min(t, duration_s_);
   row->segment = script_->segment_at(t_script);
   if (manual_hand_) {
@@ -405,16 +409,13 @@ void ClosedLoop::tick(TraceRow* row) {
   }
 
   injector_->set_time_s(t);
-  row->servo = servo_tick(guard_.get(), controller_.get(), &row->out);
+  // the chain: the reading through the guard (and the safety layer), the
+  // controller, the write; the loop's clock is simulated time
+  chain_->tick(t, t, row);
+  // what the (possibly injected) sensor said, even where the guard refused
   row->q_dh = device_to_dh_joints(injector_->last_reading());
   row->fault_injected = injector_->active();
-  row->guard = guard_->last_fault();
-  if (reference_) {
-    reference_->tick(row->q_dh, &reference_out_);
-    row->force_reference_N = reference_out_.force_device_N;
-  }
   row->motor_torque_Nm = device_->motor_torque_Nm();
-  row->d_path_mm = distance_to_path_mm(row->out.p_rm_mm);
   const OmniParams& omni = params_.omni;
   row->q_true_dh = device_->true_q_dh();
   OmniPose pose_true;
@@ -448,6 +449,7 @@ void ClosedLoop::tick(TraceRow* row) {
                       all_finite(d->qvel, m->nv) && all_finite(d->qacc, m->nv) &&
                       all_finite(d->ctrl, m->nu);
   row->hand_force_N = base_to_device_vector(hand_->force_N());
+  row->has_truth = true;
   ++tick_count_;
   substep_count_ += n;
 }

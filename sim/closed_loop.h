@@ -10,9 +10,12 @@
 //      hand's wrench is recomputed at every step (and at every RK4 stage)
 //      by the hand's own mjcb_control (sim/hand.h), installed once: plain
 //      mj_step on data() gives the same physics.
-// servo_tick talks to the device through two decorators (sim/fault_injector.h):
-// ReadingGuard (the device layer's plausibility check, `sensor_guard`) over
-// FaultInjector (the case's `fault`, none by default) over SimDevice.
+// The servo tick is the one servo chain (device/servo_chain.h), the same a
+// session on a device runs: [SafetyLayer (the case's `safety_layer`, off
+// by default)] over ReadingGuard (the device layer's plausibility check,
+// `sensor_guard`) over FaultInjector (sim/fault_injector.h: the case's
+// `fault`, none by default) over SimDevice. Each tick fills one TickRecord
+// (device/tick_record.h), the chain's part and the plant's truth.
 //
 // Servo jitter (`servo_jitter_s`): each tick's true period is drawn from
 // [min, max] in whole physics steps, and the torque is held over it; the
@@ -40,9 +43,10 @@
 #include <vector>
 
 #include "controller/controller.h"
-#include "device/servo_tick.h"
-#include "sim/case_config.h"
 #include "device/reading_guard.h"
+#include "device/servo_chain.h"
+#include "device/tick_record.h"
+#include "sim/case_config.h"
 #include "sim/fault_injector.h"
 #include "sim/omni_model_edit.h"
 #include "sim/hand.h"
@@ -51,45 +55,6 @@
 #include "sim/sim_device.h"
 
 namespace vmh::sim {
-
-// One servo tick of a run. Device frame and mm unless named.
-struct TraceRow {
-  double t_s = 0.0;
-  // the reading the device layer produced (rad): what the controller
-  // received unless the guard refused it (an injected fault included; NaN
-  // if the read itself failed)
-  Joints q_dh = Joints::Zero();
-  ControlOutput out;              // the controller's output for this tick
-  ServoTickResult servo;
-  Vec3 motor_torque_Nm = Vec3::Zero();  // held by the motors (after delay)
-  ScriptPose hand_target;         // wrist-centre target and stylus axis
-  Vec3 hand_force_N = Vec3::Zero();  // the hand's force on the grip, device frame
-  double d_path_mm = 0.0;         // RM wrist centre to the VM's path (closed form)
-  // ground truth, independent of the sensor and the placement: the true
-  // wrist centre (omni_fk of the model's joint angles) and the nearest point
-  // of the path to it, in closed form
-  Vec3 p_true_mm = Vec3::Zero();
-  Vec3 nearest_true_mm = Vec3::Zero();
-  int segment = 0;                // index into HandScript::segments()
-  // the force a reference gain set would have asked for at the same reading
-  // (for claims that compare cases); NaN when there is none
-  Vec3 force_reference_N = Vec3::Constant(std::nan(""));
-
-  // MuJoCo's joint angles at the start of the tick, DH (rad)
-  Joints q_true_dh = Joints::Zero();
-  // the true period of this tick (servo jitter) and its physics steps
-  double period_s = 0.0;
-  int substeps = 0;
-  bool fault_injected = false;            // the injector corrupted the reading
-  GuardFault guard = GuardFault::kNone;   // what the device layer's check found
-  // passivity observer: energy put into the device since t = 0 by the
-  // motors and by the hand, at the end of this tick, J (see above)
-  double energy_motor_J = 0.0;
-  double energy_hand_J = 0.0;
-  double kinetic_J = 0.0;  // the mechanism's kinetic energy after the tick
-  // qpos, qvel, qacc and ctrl all finite after the tick
-  bool state_finite = true;
-};
 
 // Where MuJoCo's state went bad: the first physics step after which
 // mjData::warning[] counted a bad qpos, qvel, qacc or ctrl (NaN, inf or
@@ -129,7 +94,9 @@ class ClosedLoop {
   // cleared.
   void reset();
 
-  // Advances one servo period and describes it in *row. Past duration_s
+  // Advances one servo period and describes it in *row (every field: the
+  // chain's and the truth, has_truth set; period_s is this tick's own
+  // length, n physics steps). Past duration_s
   // (a run continued beyond its script) the hand holds the script's last
   // target, at rest. After every physics step it reads mjData::warning[]
   // (counted per kind, mujoco_warning_counts()) and checks the state; the
@@ -137,7 +104,7 @@ class ClosedLoop {
   // row->state_finite is false. tick() itself goes on (a study may want to
   // see what follows): a run that must stop calls throw_if_physics_fault()
   // after each tick.
-  void tick(TraceRow* row);
+  void tick(TickRecord* row);
 
   // the first bad physics state since reset(), if any
   const std::optional<PhysicsFault>& physics_fault() const {
@@ -152,7 +119,7 @@ class ClosedLoop {
   }
 
   // Another gain set evaluated on every reading, without acting
-  // (TraceRow::force_reference_N).
+  // (TickRecord::force_reference_N).
   void set_reference(const ControllerParams& params);
 
   double time_s() const;
@@ -167,18 +134,20 @@ class ClosedLoop {
   int substeps_min() const { return jitter_lo_; }
   int substeps_max() const { return jitter_hi_; }
   bool jitter() const { return jitter_; }
-  // the passivity observer's totals so far, J (TraceRow says what they are)
+  // the passivity observer's totals so far, J (see the file comment)
   double energy_motor_J() const { return energy_motor_J_; }
   double energy_hand_J() const { return energy_hand_J_; }
   const CaseConfig& config() const { return config_; }
   const ControllerParams& controller_params() const { return params_; }
   const HandScript& script() const { return *script_; }
-  const Controller& controller() const { return *controller_; }
+  const Controller& controller() const { return *chain_->controller(); }
   const mjModel* model() const { return model_.get(); }
   mjData* data() { return data_.get(); }
   SimDevice& device() { return *device_; }
   FaultInjector& injector() { return *injector_; }
-  ReadingGuard& guard() { return *guard_; }
+  ReadingGuard& guard() { return chain_->guard(); }
+  // the servo chain (its safety layer, when the case has one)
+  ServoChain& chain() { return *chain_; }
   SimHand& hand() { return *hand_; }
   // Sets the hand's target (and its velocity) for simulated time t_s from
   // the script, as tick() does before it steps: what a caller that steps
@@ -187,7 +156,7 @@ class ClosedLoop {
 
   // Manual hand (a viewer's mouse in the script's place): while on, tick()
   // holds the manual target instead of the script's (the hand's impedance
-  // still acts at every physics step), and TraceRow::hand_target is the
+  // still acts at every physics step), and TickRecord::hand_target is the
   // wrist pose that target asks for. Turning it on starts from the target
   // the hand holds now, so nothing jumps; reset() keeps the mode and puts
   // the manual target back at the script's start. Off by default: the
@@ -209,8 +178,9 @@ class ClosedLoop {
  private:
   // construction, in order: the scene's <option>s (physics step,
   // integrator); the servo period in physics steps, the run's length and
-  // the jitter; the controller (and the gimbal limits); the device chain
-  // SimDevice <- FaultInjector <- ReadingGuard; the start pose (sets
+  // the jitter; the controller's parameters (and the gimbal limits); the
+  // device chain SimDevice <- FaultInjector <- ServoChain (guard, safety,
+  // controller); the start pose (sets
   // R_start_base_, returns the joint angles)
   void apply_model_options();
   void setup_timing();
@@ -241,11 +211,8 @@ class ClosedLoop {
   std::unique_ptr<SimHand> hand_;
   std::unique_ptr<SimDevice> device_;
   std::unique_ptr<FaultInjector> injector_;
-  std::unique_ptr<ReadingGuard> guard_;
-  std::unique_ptr<Controller> controller_;
-  std::unique_ptr<Controller> reference_;
+  std::unique_ptr<ServoChain> chain_;
   std::unique_ptr<HandScript> script_;
-  ControlOutput reference_out_;
   Joints q_start_dh_ = Joints::Zero();
   Mat3 R_start_base_ = Mat3::Identity();  // stylus frame at the start pose
   // the grip site in the stylus body: offset (m) and rotation

@@ -4,6 +4,9 @@
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
+#ifdef __linux__
+#include <sys/prctl.h>
+#endif
 
 #include <algorithm>
 #include <array>
@@ -137,6 +140,7 @@ struct Emulator::PhysicsState {
   ScriptPose target;
   int segment = 0;
   HandProgram program = HandProgram::kTour;
+  Joints q_start_dh = Joints::Zero();  // the true angles at the period's start
 };
 
 Emulator::Emulator(const EmulatorOptions& options) : options_(options) {
@@ -232,8 +236,14 @@ void Emulator::start() {
   unplugged_.store(false);
   t_sim_now_s_.store(0.0);
   stop_.store(false);
-  publish(monotonic_now_s());
+  lockstep_periods_.store(0);
+  frozen_until_s_ = -1.0;
+  starved_reads_.store(0);
+  // the start's truth: the state at rest, before any period
+  ps_->q_start_dh = loop_->device().true_q_dh();
+  publish(clock_s());
   running_.store(true);
+  if (options_.lockstep) return;  // advance() runs the periods
   try {
     thread_ = std::thread([this] { run(); });
   } catch (const std::system_error& e) {
@@ -250,12 +260,49 @@ void Emulator::stop() noexcept {
   if (loop_) loop_->device().reset();  // zero torque at the motors
 }
 
+double Emulator::clock_s() const noexcept {
+  if (options_.lockstep) {
+    return static_cast<double>(lockstep_periods_.load(std::memory_order_relaxed)) *
+           period_s_;
+  }
+  return monotonic_now_s();
+}
+
+void Emulator::advance() noexcept {
+  if (!options_.lockstep || !running_.load(std::memory_order_relaxed)) return;
+  // the clock moves on first: the period's reading is stamped at its end,
+  // when the next tick reads it
+  lockstep_periods_.fetch_add(1, std::memory_order_relaxed);
+  const double now_s = clock_s();
+  if (now_s <= frozen_until_s_ + 1e-12) return;  // a stall: nothing moves
+  const double freeze_s = step_period();
+  if (freeze_s > 0.0) frozen_until_s_ = now_s + freeze_s;
+}
+
+std::string Emulator::stall_cause() const {
+  if (options_.lockstep) return {};
+  const long starved = starved_reads_.load();
+  const long lag = truth_.read().lag_periods;
+  if (starved == 0 && lag == 0) return {};
+  return "the emulator's physics thread fell behind the wall clock (" +
+         std::to_string(starved) + " reads found no fresh state, " +
+         std::to_string(lag) +
+         " periods dropped): the host did not give it the CPU; run with "
+         "--clock lockstep, or give the process real-time priority "
+         "(CAP_SYS_NICE)";
+}
+
 void Emulator::run() noexcept {
   if (options_.realtime_priority > 0) {
     // best effort: refused without CAP_SYS_NICE, and then it runs as before
     sched_param sp{};
     sp.sched_priority = options_.realtime_priority;
-    (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+    if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) != 0) {
+#ifdef __linux__
+      // as the servo thread does without SCHED_FIFO: sleeps end on time
+      prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+#endif
+    }
   }
   const std::int64_t period_ns = to_ns(period_s_ / options_.realtime_factor);
   std::int64_t deadline_ns = to_ns(monotonic_now_s());
@@ -265,10 +312,12 @@ void Emulator::run() noexcept {
       // a stall: the thread does nothing, in short sleeps so stop() is
       // not held up
       const std::int64_t until = to_ns(monotonic_now_s()) + to_ns(freeze_s);
+      frozen_.store(true);
       while (!stop_.load(std::memory_order_relaxed) &&
              to_ns(monotonic_now_s()) < until) {
         sleep_until_ns(std::min(until, to_ns(monotonic_now_s()) + 1000000));
       }
+      frozen_.store(false);
       deadline_ns = to_ns(monotonic_now_s());
       continue;
     }
@@ -344,7 +393,9 @@ double Emulator::step_period() noexcept {
   ps.hand.set_target(program, ps.t_sim_s, &ps.target, &ps.segment);
   // the command reaches the motors through SimDevice: its clamps and its
   // delay line (one write per period)
-  loop_->device().write_motor_torques(motor_command(monotonic_now_s()));
+  loop_->device().write_motor_torques(motor_command(clock_s()));
+  // the period's start, as the closed loop records a tick's
+  ps.q_start_dh = loop_->device().true_q_dh();
 
   const mjModel* m = loop_->model();
   mjData* d = loop_->data();
@@ -360,7 +411,7 @@ double Emulator::step_period() noexcept {
   ++ps.periods;
   ps.t_sim_s = static_cast<double>(ps.periods) * period_s_;
   t_sim_now_s_.store(ps.t_sim_s, std::memory_order_relaxed);
-  publish(monotonic_now_s());
+  publish(clock_s());
   ps.stalled = false;
   return 0.0;
 }
@@ -383,7 +434,7 @@ void Emulator::publish(double now_s) noexcept {
     s.gimbal_pots = hw::pot_codes_from_angles(q_meas.tail<3>(), factory_);
     s.q_device_rad = hw::angles_from_raw(s.encoder_counts, s.gimbal_pots, cal_.read());
     apply_seeded_readings(options_.seeded, &s.q_device_rad);
-    s.docked = ps.hand.docked(q_dh, &t.p_true_mm, &t.stylus_axis);
+    s.docked = ps.hand.docked(q_dh, &t.p_end_mm, &t.stylus_axis);
     ps.kinematics.fill(m, d, &s);
   }
   s.timestamp_s = now_s;
@@ -407,11 +458,17 @@ void Emulator::publish(double now_s) noexcept {
   t.wall_s = now_s;
   t.periods = ps.periods;
   t.lag_periods = ps.lag;
-  t.q_true_dh = q_dh;
-  if (p.finite) {
+  t.q_end_dh = q_dh;
+  // the period's start (the closed loop's record of a tick, PlantTruth)
+  t.q_true_dh = ps.q_start_dh;
+  if (ps.q_start_dh.allFinite()) {
+    const OmniParams& omni = loop_->controller_params().omni;
+    OmniPose pose;
+    omni_fk_jacobian(omni, ps.q_start_dh, &pose, nullptr);
+    t.p_true_mm = base_to_device_mm(omni, pose.p_base_m);
     t.nearest_true_mm = loop_->nearest_on_path_mm(t.p_true_mm);
-    t.d_path_mm = loop_->distance_to_path_mm(t.p_true_mm);
   }
+  t.substeps = ps.periods > 0 ? substeps_ : 0;
   t.hand_force_N = base_to_device_vector(loop_->hand().force_N());
   t.hand_target = ps.target;
   t.segment = ps.segment;
@@ -445,7 +502,14 @@ DeviceError Emulator::read_state(DeviceState* state) noexcept {
   }
   const Published p = state_.read();
   const double stale_s = kStaleReadPeriods * period_s_ / options_.realtime_factor;
-  if (monotonic_now_s() - p.publish_wall_s > stale_s) return DeviceError::kTimeout;
+  if (clock_s() - p.publish_wall_s > stale_s) {
+    // behind by the host's doing, not a stall fault's: the emulator's own
+    // problem (stall_cause), not the device's
+    if (!options_.lockstep && !frozen_.load(std::memory_order_relaxed)) {
+      starved_reads_.fetch_add(1, std::memory_order_relaxed);
+    }
+    return DeviceError::kTimeout;
+  }
   if (!p.finite) return DeviceError::kSensorFault;
   *state = p.state;
   state->buttons = buttons_.load(std::memory_order_relaxed);
@@ -464,7 +528,7 @@ DeviceError Emulator::write_motor_torques(const Vec3& tau_motor_Nm) noexcept {
   Command c;
   c.invalid = !tau_motor_Nm.allFinite();
   c.tau_Nm = c.invalid ? Vec3::Zero() : tau_motor_Nm;
-  c.wall_s = monotonic_now_s();
+  c.wall_s = clock_s();
   c.count = writes_.fetch_add(1, std::memory_order_relaxed) + 1;
   command_.write(c);
   return c.invalid ? DeviceError::kInvalidCommand : DeviceError::kOk;

@@ -2,6 +2,14 @@
 // the hand) stepped in real time in its own thread behind HapticDevice, so
 // that every `hw` command runs without hardware.
 //
+// Clocks. On the wall clock (the default) the physics runs in a thread of
+// its own, described next. In lockstep (EmulatorOptions::lockstep) there
+// is no thread: advance() runs one servo period on the caller's thread
+// (the session's, through device/lockstep.h), and the emulator's clock is
+// the number of periods advanced times the period; every time the
+// emulator reads (staleness, the device watchdog, time stamps) is on that
+// clock, so the same settings give the same readings to the last bit.
+//
 // Threads. The physics thread (start()/stop()) runs one servo period
 // (the case's servo_period_s) at a time: it sets the hand's target from the
 // hand program at emulator time, applies the latest motor command through
@@ -77,6 +85,7 @@
 #include "device/device_backend.h"
 #include "device/haptic_device.h"
 #include "device/seqlock.h"
+#include "device/tick_record.h"
 #include "hw/omni_calibration.h"
 #include "sim/hand_script.h"
 #include "sim/omni_model_edit.h"
@@ -121,13 +130,9 @@ inline constexpr double kTourPeriod_s = 8.0;
 inline constexpr double kTourAmplitude_mm = 50.0;
 inline constexpr double kSweepLeg_s = 1.0;
 
-// The inkwell (dock) pose, device convention, rad: an ESTIMATE. t1..t3 put
-// the wrist centre at OpenHaptics's inkwell position (0, -65.5, -88.1) mm
-// (docs/omni.md), t5 tilts the stylus 36 deg below horizontal, tip forward;
-// nobody has measured it on a device. Within the ranges of docs/sources.md
-// §5 (OmniParams).
-inline constexpr double kInkwellDevice_rad[6] = {0.0,  -0.647, -0.477,
-                                                 0.0,  1.0,    0.0};
+// The inkwell (dock) pose: hw::kInkwellDevice_rad (hw/omni_calibration.h),
+// which `hw calibrate` fits the encoder offsets to.
+using hw::kInkwellDevice_rad;
 // the inkwell switch closes when the true wrist centre is within this of
 // the inkwell's and the stylus axis within this angle of the inkwell's
 inline constexpr double kDockRadius_mm = 5.0;
@@ -202,6 +207,8 @@ std::vector<EmulatorFault> parse_emulator_faults(const std::string& text);
 void validate_emulator_fault(const EmulatorFault& fault);
 
 struct EmulatorOptions {
+  // lockstep: no physics thread; advance() runs each period (see above)
+  bool lockstep = false;
   // a scene ClosedLoop can load; empty: models/cases/case1.xml of the
   // models directory the build was configured with
   std::string scene;
@@ -221,28 +228,21 @@ struct EmulatorOptions {
   SeededFaults seeded;  // the device's hidden built-in mistakes
 };
 
-// Ground truth of the last period, for tests and for the trace of a
-// real-time run (sim::TraceRow's truth fields). Device frame, mm, unless
-// named.
-struct EmulatorTruth {
+// Ground truth of the last period. Its PlantTruth part describes the
+// period as the simulated closed loop's record describes a tick
+// (device/tick_record.h): the true joint angles and wrist centre at the
+// period's start, the hand's target and the motors' torque over it, the
+// energies, the hand's force and the state's finiteness at its end. The
+// rest is the emulator's own. Device frame, mm, unless named.
+struct EmulatorTruth : PlantTruth {
   double t_sim_s = 0.0;       // emulator time at the end of the period
-  double wall_s = 0.0;        // CLOCK_MONOTONIC when published
+  double wall_s = 0.0;        // the emulator's clock when published
   long periods = 0;           // periods stepped since start()
   long lag_periods = 0;       // periods dropped to stay in real time
-  Joints q_true_dh = Joints::Zero();  // MuJoCo's joint angles, DH, rad
-  Vec3 p_true_mm = Vec3::Zero();      // omni_fk of q_true_dh
-  Vec3 nearest_true_mm = Vec3::Zero();  // nearest point of the VM's path
-  double d_path_mm = 0.0;             // distance of p_true_mm to the path
-  Vec3 stylus_axis = Vec3::UnitZ();   // true stylus axis, unit
-  Vec3 hand_force_N = Vec3::Zero();   // the hand's force on the grip
-  ScriptPose hand_target;             // the hand program's target
-  int segment = 0;                    // kCase: index into the script's segments
+  Joints q_end_dh = Joints::Zero();   // MuJoCo's joint angles at the end
+  Vec3 p_end_mm = Vec3::Zero();       // the true wrist centre at the end
+  Vec3 stylus_axis = Vec3::UnitZ();   // true stylus axis at the end, unit
   HandProgram program = HandProgram::kTour;
-  Vec3 motor_torque_Nm = Vec3::Zero();  // held by the motors (after delay)
-  double energy_motor_J = 0.0;  // passivity observer, as ClosedLoop's
-  double energy_hand_J = 0.0;
-  double kinetic_J = 0.0;
-  bool state_finite = true;
   bool docked = false;
   bool device_watchdog_fired = false;  // zero held: no write in time
   bool invalid_command = false;        // the last write was not finite
@@ -263,9 +263,21 @@ class Emulator final : public HapticDevice {
   Emulator(const Emulator&) = delete;
   Emulator& operator=(const Emulator&) = delete;
 
-  // Launches the physics thread (emulator time 0). Throws DeviceOpenError
-  // if it is already running or cannot be started.
+  // Launches the physics thread (emulator time 0); in lockstep, only
+  // resets to time 0. Throws DeviceOpenError if it is already running or
+  // cannot be started.
   void start();
+  // lockstep only: one servo period (the last command held), then the
+  // clock moves on by the period. No allocation, no exception, no sleep.
+  void advance() noexcept;
+  bool lockstep() const noexcept { return options_.lockstep; }
+  // The emulator's clock, s: CLOCK_MONOTONIC, or in lockstep the periods
+  // advanced times the period.
+  double clock_s() const noexcept;
+  // When reads time out because the physics thread fell behind the wall
+  // clock (a busy host, not an injected fault): why, in one line; empty
+  // otherwise (and always in lockstep).
+  std::string stall_cause() const;
   // Joins the physics thread; idempotent.
   void stop() noexcept;
   bool running() const noexcept { return running_.load(); }
@@ -355,6 +367,12 @@ class Emulator final : public HapticDevice {
   std::atomic<std::uint64_t> writes_{0};  // the servo thread's count
   std::atomic<double> start_wall_s_{0.0};
   std::atomic<double> t_sim_now_s_{0.0};
+  // lockstep: the clock (periods advanced), and a stall's end on it
+  std::atomic<long> lockstep_periods_{0};
+  double frozen_until_s_ = -1.0;
+  std::atomic<bool> frozen_{false};  // the physics thread is in a stall
+  // reads that timed out because the physics was behind, not by a fault
+  std::atomic<long> starved_reads_{0};
   FaultSlot faults_[kMaxFaults];
   std::atomic<int> fault_count_{0};
 

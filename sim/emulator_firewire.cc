@@ -262,8 +262,9 @@ void EmulatorFirewireTransport::start() {
   taken_.fill(false);
   taken_count_ = 0;
   reset_pending_.store(false);
-  start_wall_s_ = monotonic_now_s();
   emu_->start();
+  // the emulator's clock (lockstep: its periods) is the packets' time base
+  start_wall_s_ = emu_->clock_s();
 }
 
 void EmulatorFirewireTransport::stop() noexcept {

@@ -18,14 +18,13 @@
 #include <vector>
 
 #include "controller/controller.h"
+#include "device/tick_record.h"
 #include "sim/case_config.h"
 
 namespace vmh::sim {
 
-struct ScriptPose {
-  Vec3 p_mm = Vec3::Zero();      // wrist centre, device frame
-  Vec3 axis = Vec3::UnitZ();     // stylus axis, device frame
-};
+// ScriptPose (a wrist-centre target and a stylus axis, device frame) is
+// vmh::ScriptPose, device/tick_record.h: records carry it
 
 // A named stretch of the script. Claims use its settled window (the second
 // half of a hold, after the transition), never the transition.

@@ -24,12 +24,12 @@ double angle_deg(const Vec3& a, const Vec3& b) {
 }
 
 // rows in the settled windows of the named segments
-std::vector<const TraceRow*> settled(const std::vector<TraceRow>& rows,
+std::vector<const TickRecord*> settled(const std::vector<TickRecord>& rows,
                                      const HandScript& script,
                                      const std::set<std::string>& names) {
-  std::vector<const TraceRow*> out;
+  std::vector<const TickRecord*> out;
   const auto& segs = script.segments();
-  for (const TraceRow& r : rows) {
+  for (const TickRecord& r : rows) {
     const ScriptSegment& s = segs[static_cast<std::size_t>(r.segment)];
     if (names.count(s.name) && r.t_s >= s.settled_from_s()) out.push_back(&r);
   }
@@ -87,7 +87,7 @@ MetricsAccumulator::MetricsAccumulator(const ClosedLoop& loop)
     : T_s_(loop.controller_params().servo_period_s),
       has_settle_(loop.script().segments().size() > 1) {}
 
-void MetricsAccumulator::add(const TraceRow& r) {
+void MetricsAccumulator::add(const TickRecord& r) {
   RunMetrics& m = m_;
   ++m.ticks;
   const ControlStatus s = r.out.status;
@@ -123,10 +123,10 @@ RunMetrics MetricsAccumulator::result() const {
   return m;
 }
 
-RunMetrics run_metrics(const std::vector<TraceRow>& rows,
+RunMetrics run_metrics(const std::vector<TickRecord>& rows,
                        const ClosedLoop& loop) {
   MetricsAccumulator acc(loop);
-  for (const TraceRow& r : rows) acc.add(r);
+  for (const TickRecord& r : rows) acc.add(r);
   return acc.result();
 }
 
@@ -187,17 +187,17 @@ namespace {
 // the law's prediction at every row's ground-truth pose (index as rows)
 class Predictions {
  public:
-  Predictions(const std::vector<TraceRow>& rows, const ControllerParams& p)
+  Predictions(const std::vector<TickRecord>& rows, const ControllerParams& p)
       : rows_(&rows), p_(p) {
     at_.reserve(rows.size());
-    for (const TraceRow& r : rows) at_.push_back(predict(r, p));
+    for (const TickRecord& r : rows) at_.push_back(predict(r, p));
   }
-  const LawPrediction& at(const TraceRow* r) const {
+  const LawPrediction& at(const TickRecord* r) const {
     return at_[static_cast<std::size_t>(r - rows_->data())];
   }
   // at the ground-truth pose of a row, device frame: the row's true wrist
   // centre (omni_fk of q_true_dh) and the stylus axis of the same angles
-  static LawPrediction predict(const TraceRow& r, const ControllerParams& p) {
+  static LawPrediction predict(const TickRecord& r, const ControllerParams& p) {
     const OmniPose pose = omni_fk(p.omni, r.q_true_dh);
     return predict_static_law(p, r.p_true_mm,
                               base_to_device_vector(pose.R_base.col(2)),
@@ -206,20 +206,20 @@ class Predictions {
   const ControllerParams& params() const { return p_; }
 
  private:
-  const std::vector<TraceRow>* rows_;
+  const std::vector<TickRecord>* rows_;
   ControllerParams p_;
   std::vector<LawPrediction> at_;
 };
 
 std::vector<Claim> measure_claims(int thesis_case,
-                                  const std::vector<TraceRow>& rows,
+                                  const std::vector<TickRecord>& rows,
                                   const ClosedLoop& loop,
                                   const Predictions& pred);
 
 }  // namespace
 
 std::vector<Claim> evaluate_claims(int thesis_case,
-                                   const std::vector<TraceRow>& rows,
+                                   const std::vector<TickRecord>& rows,
                                    const ClosedLoop& loop) {
   const Predictions pred(rows, loop.controller_params());
   std::vector<Claim> claims = measure_claims(thesis_case, rows, loop, pred);
@@ -236,7 +236,7 @@ std::vector<Claim> evaluate_claims(int thesis_case,
     const bool whole = names.count("sweep") > 0;
     double sum = 0.0;
     int n = 0, limited = 0;
-    for (const TraceRow& r : rows) {
+    for (const TickRecord& r : rows) {
       const ScriptSegment& s =
           loop.script().segments()[static_cast<std::size_t>(r.segment)];
       if (names.count(s.name) && (whole || r.t_s >= s.settled_from_s())) {
@@ -283,7 +283,7 @@ constexpr const char* kStaticNote =
 // force toward X(theta_V). (The thesis's third statement, "independent of
 // X(theta_R)", is the first one again: with K_ornt = 0 nothing in the law
 // reads X(theta_R), so on the path the force is K_pos times the distance.)
-void position_claims(const std::vector<TraceRow>& rows, const HandScript& script,
+void position_claims(const std::vector<TickRecord>& rows, const HandScript& script,
                      const Predictions& pred, std::vector<Claim>* claims_out) {
   std::vector<Claim>& claims = *claims_out;
   const std::set<std::string> off = {"off_out", "off_out_misaligned", "off_in"};
@@ -291,7 +291,7 @@ void position_claims(const std::vector<TraceRow>& rows, const HandScript& script
   {
     const auto w = settled(rows, script, on);
     std::vector<double> f, fp;
-    for (const TraceRow* r : w) {
+    for (const TickRecord* r : w) {
       f.push_back(r->out.force_device_N.norm());
       const LawPrediction& lp = pred.at(r);
       if (lp.available) fp.push_back(lp.force_limited_N.norm());
@@ -314,7 +314,7 @@ void position_claims(const std::vector<TraceRow>& rows, const HandScript& script
     const auto w = settled(rows, script, off);
     double worst = 0.0, worst_p = 0.0;
     int n = 0, np = 0;
-    for (const TraceRow* r : w) {
+    for (const TickRecord* r : w) {
       const double a =
           angle_deg(r->out.force_device_N, r->nearest_true_mm - r->p_true_mm);
       if (std::isfinite(a)) {
@@ -345,7 +345,7 @@ void position_claims(const std::vector<TraceRow>& rows, const HandScript& script
 
 // Cases 2, 3, 4 and 6, position and orientation: off the path the force
 // points between X(theta_V) and X(theta_R), on it toward X(theta_R), felt.
-void orientation_claims(const std::vector<TraceRow>& rows,
+void orientation_claims(const std::vector<TickRecord>& rows,
                         const HandScript& script, const Predictions& pred,
                         std::vector<Claim>* claims_out) {
   std::vector<Claim>& claims = *claims_out;
@@ -362,7 +362,7 @@ void orientation_claims(const std::vector<TraceRow>& rows,
   {
     const auto w = settled(rows, script, off_mis);
     int good = 0, n = 0, good_p = 0, np = 0;
-    for (const TraceRow* r : w) {
+    for (const TickRecord* r : w) {
       bool ok = false;
       const bool g = between(r->out.force_device_N, r->out.x_v_mm,
                              r->out.x_r_mm, r->out.p_rm_mm, &ok);
@@ -394,7 +394,7 @@ void orientation_claims(const std::vector<TraceRow>& rows,
     const auto w = settled(rows, script, on);
     std::vector<double> f, fp;
     int toward = 0, toward_p = 0;
-    for (const TraceRow* r : w) {
+    for (const TickRecord* r : w) {
       const Vec3 F = r->out.force_device_N;
       f.push_back(F.norm());
       if (F.dot(r->out.x_r_mm - r->out.p_rm_mm) > 0.0) ++toward;
@@ -429,13 +429,13 @@ void orientation_claims(const std::vector<TraceRow>& rows,
 }
 
 // Case 2's "bending feel" on a circle: along the path, not across it.
-void along_path_claim(const std::vector<TraceRow>& rows, const HandScript& script,
+void along_path_claim(const std::vector<TickRecord>& rows, const HandScript& script,
                       const Predictions& pred, std::vector<Claim>* claims) {
   const ControllerParams& p = pred.params();
   const std::set<std::string> on = {"on_misaligned_a", "on_misaligned_b"};
   const auto w = settled(rows, script, on);
   std::vector<double> a, ap;
-  for (const TraceRow* r : w) {
+  for (const TickRecord* r : w) {
     const double x =
         angle_deg(r->out.force_device_N,
                   along_path_toward_xr(r->out.x_v_mm, r->out.x_r_mm, p));
@@ -459,7 +459,7 @@ void along_path_claim(const std::vector<TraceRow>& rows, const HandScript& scrip
 
 // Cases 3 and 4: position (3) or orientation (4) weighs more than in case 2,
 // the same readings through case 2's gains.
-void weighting_claim(int thesis_case, const std::vector<TraceRow>& rows,
+void weighting_claim(int thesis_case, const std::vector<TickRecord>& rows,
                      const HandScript& script, const Predictions& pred,
                      std::vector<Claim>* claims) {
   const ControllerParams& p = pred.params();
@@ -467,7 +467,7 @@ void weighting_claim(int thesis_case, const std::vector<TraceRow>& rows,
   const std::set<std::string> off_mis = {"off_out_misaligned"};
   const auto w = settled(rows, script, off_mis);
   std::vector<double> mine, theirs, mine_p, theirs_p;
-  for (const TraceRow* r : w) {
+  for (const TickRecord* r : w) {
     const Vec3 dv = r->out.x_v_mm - r->out.p_rm_mm;
     const double a = angle_deg(r->out.force_device_N, dv);
     const double b = angle_deg(r->force_reference_N, dv);
@@ -514,12 +514,12 @@ void weighting_claim(int thesis_case, const std::vector<TraceRow>& rows,
 
 // Case 4 (Fig. 4.12): farther from the path the force is much greater than
 // on it.
-void force_grows_claim(const std::vector<TraceRow>& rows,
+void force_grows_claim(const std::vector<TickRecord>& rows,
                        const HandScript& script, const Predictions& pred,
                        std::vector<Claim>* claims) {
   const std::set<std::string> sweep = {"sweep"};
   std::vector<double> far, near, far_p, near_p;
-  for (const TraceRow& r : rows) {
+  for (const TickRecord& r : rows) {
     if (script.segments()[static_cast<std::size_t>(r.segment)].name != "sweep")
       continue;
     const double f = r.out.force_device_N.norm();
@@ -548,7 +548,7 @@ void force_grows_claim(const std::vector<TraceRow>& rows,
 }
 
 std::vector<Claim> measure_claims(int thesis_case,
-                                  const std::vector<TraceRow>& rows,
+                                  const std::vector<TickRecord>& rows,
                                   const ClosedLoop& loop,
                                   const Predictions& pred) {
   std::vector<Claim> claims;

@@ -111,7 +111,7 @@ inline constexpr double kOnPathMm = 1.0;
 class MetricsAccumulator {
  public:
   explicit MetricsAccumulator(const sim::ClosedLoop& loop);
-  void add(const sim::TraceRow& r);
+  void add(const TickRecord& r);
   RunMetrics result() const;
 
  private:
@@ -123,7 +123,7 @@ class MetricsAccumulator {
 };
 
 // RunMetrics over all of `rows`.
-RunMetrics run_metrics(const std::vector<sim::TraceRow>& rows,
+RunMetrics run_metrics(const std::vector<TickRecord>& rows,
                        const sim::ClosedLoop& loop);
 
 // The gains a case's claims compare against (case 2's for cases 3 and 4),
@@ -133,7 +133,7 @@ std::optional<ControllerParams> reference_params(int thesis_case,
 
 // The claims of thesis case 1..6 measured on `rows` (empty for 0).
 std::vector<Claim> evaluate_claims(int thesis_case,
-                                   const std::vector<sim::TraceRow>& rows,
+                                   const std::vector<TickRecord>& rows,
                                    const sim::ClosedLoop& loop);
 
 }  // namespace vmh::studies

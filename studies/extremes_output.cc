@@ -197,13 +197,13 @@ std::string extremes_csv(const std::vector<ExtremeResult>& results) {
   return s;
 }
 
-std::string extreme_series_csv(const std::vector<TraceRow>& rows) {
+std::string extreme_series_csv(const std::vector<TickRecord>& rows) {
   std::string s =
       "t_s,period_s,F_N,tau_1_Nm,tau_2_Nm,tau_3_Nm,energy_motor_J,"
       "energy_hand_J,kinetic_J,d_pivot_mm,status,read,guard\n";
   s.reserve(rows.size() * 160);
   char buf[320];
-  for (const TraceRow& r : rows) {
+  for (const TickRecord& r : rows) {
     std::snprintf(buf, sizeof buf,
                   "%.6f,%.6g,%.6g,%.6g,%.6g,%.6g,%.9g,%.9g,%.9g,%.6g,%u,%s,%s\n",
                   r.t_s, r.period_s, r.out.force_device_N.norm(),
@@ -216,7 +216,7 @@ std::string extreme_series_csv(const std::vector<TraceRow>& rows) {
   return s;
 }
 
-EnergyCurve thin_energy(const std::vector<TraceRow>& rows, std::size_t buckets) {
+EnergyCurve thin_energy(const std::vector<TickRecord>& rows, std::size_t buckets) {
   EnergyCurve e;
   const std::size_t stride =
       std::max<std::size_t>(1, rows.size() / std::max<std::size_t>(1, buckets));

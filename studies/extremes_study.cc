@@ -87,7 +87,7 @@ std::string join(const std::vector<std::string>& v, const char* sep) {
 
 // every output of a tick that must stay finite (the reading itself may be
 // NaN by injection and is checked apart)
-const char* nonfinite_part(const TraceRow& r) {
+const char* nonfinite_part(const TickRecord& r) {
   const ControlOutput& o = r.out;
   if (!o.force_device_N.allFinite()) return "force_device_N";
   if (!o.tau_motor_Nm.allFinite()) return "tau_motor_Nm";
@@ -203,7 +203,7 @@ void read_limits(const ClosedLoop& loop, ExtremeResult* r) {
 
 // Ticks the loop until end_s, a row per tick; the wall time and the ticks
 // go in r.
-void run_ticks(ClosedLoop* loop, double end_s, std::vector<TraceRow>* rows,
+void run_ticks(ClosedLoop* loop, double end_s, std::vector<TickRecord>* rows,
                ExtremeResult* r) {
   const mjModel* m = loop->model();
   rows->clear();
@@ -237,8 +237,8 @@ class TickScan {
     r_->min_pole_angle_rad = 1e300;
   }
 
-  void add(const std::vector<TraceRow>& rows, std::size_t k) {
-    const TraceRow& row = rows[k];
+  void add(const std::vector<TickRecord>& rows, std::size_t k) {
+    const TickRecord& row = rows[k];
     finite(row);
     command(row);
     statuses(row, static_cast<int>(k));
@@ -261,7 +261,7 @@ class TickScan {
   bool in_window() const { return in_window_; }
 
  private:
-  void finite(const TraceRow& row) {
+  void finite(const TickRecord& row) {
     if (r_->finite) {
       if (const char* part = nonfinite_part(row)) {
         r_->finite = false;
@@ -274,7 +274,7 @@ class TickScan {
   }
 
   // the command as the controller computed it and as the motors held it
-  void command(const TraceRow& row) {
+  void command(const TickRecord& row) {
     r_->max_force_N = std::max(r_->max_force_N, row.out.force_device_N.norm());
     for (int i = 0; i < 3; ++i) {
       r_->max_motor_torque_Nm[i] =
@@ -282,7 +282,7 @@ class TickScan {
     }
   }
 
-  void statuses(const TraceRow& row, int tick) {
+  void statuses(const TickRecord& row, int tick) {
     if (row.servo.read == DeviceError::kOk) seen_ |= row.out.status;
     if (row.servo.read != DeviceError::kOk) device_errors_.insert(device_error_name(row.servo.read));
     if (row.servo.write != DeviceError::kOk) device_errors_.insert(device_error_name(row.servo.write));
@@ -298,7 +298,7 @@ class TickScan {
     }
   }
 
-  void energy(const TraceRow& row) {
+  void energy(const TickRecord& row) {
     const double E = row.energy_motor_J;
     r_->energy_motor_max_J = std::max(r_->energy_motor_max_J, E);
     r_->energy_motor_min_J = std::min(r_->energy_motor_min_J, E);
@@ -317,7 +317,7 @@ class TickScan {
   }
 
   // what the scenario reached, from MuJoCo's true angles
-  void reached(const TraceRow& row, const TraceRow* prev) {
+  void reached(const TickRecord& row, const TickRecord* prev) {
     const Vec3 from_pivot = row.p_true_mm - params_.vm.pivot_mm;
     r_->min_pivot_distance_mm = std::min(r_->min_pivot_distance_mm, from_pivot.norm());
     if (from_pivot.norm() > 1e-9) {
@@ -443,11 +443,11 @@ std::vector<ExtremeScenario> pick_scenarios(const std::vector<std::string>& only
 }  // namespace
 
 ExtremeResult run_extreme(const ExtremeScenario& s,
-                          std::vector<TraceRow>* trace) {
+                          std::vector<TickRecord>* trace) {
   ExtremeResult r;
   r.scenario = s;
   std::string name;
-  const std::string scene = resolve_scene(s.base, &name);
+  const std::string scene = sim::resolve_scene(s.base, &name);
   std::vector<std::string> sets = {"duration_s=" + std::to_string(kExtremeDurationS)};
   sets.insert(sets.end(), s.overrides.begin(), s.overrides.end());
   ClosedLoop loop(scene, sets);
@@ -455,8 +455,8 @@ ExtremeResult run_extreme(const ExtremeScenario& s,
   const double script_end_s = loop.config().sim.duration_s;
   const double end_s = script_end_s + kExtremeRestS;
 
-  std::vector<TraceRow> local;
-  std::vector<TraceRow>& rows = trace != nullptr ? *trace : local;
+  std::vector<TickRecord> local;
+  std::vector<TickRecord>& rows = trace != nullptr ? *trace : local;
   run_ticks(&loop, end_s, &rows, &r);
 
   TickScan scan(loop, end_s, &r);
@@ -486,7 +486,7 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   std::atomic<std::size_t> finished{0};
   report::parallel_for(table.size(), o.jobs, [&](std::size_t i) {
-    std::vector<TraceRow> rows;
+    std::vector<TickRecord> rows;
     try {
       result.scenarios[i] = run_extreme(table[i], &rows);
       result.energy[i] = thin_energy(rows);

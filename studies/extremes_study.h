@@ -158,7 +158,7 @@ struct ExtremeResult {
 // Runs one scenario. With `trace` non-null, fills it with every tick's row.
 // Throws SimError on bad input (a bad override, an unreachable start pose).
 ExtremeResult run_extreme(const ExtremeScenario& s,
-                          std::vector<sim::TraceRow>* trace = nullptr);
+                          std::vector<TickRecord>* trace = nullptr);
 
 struct ExtremesOptions {
   std::vector<std::string> only;  // scenario names, in this order; empty: all
@@ -202,11 +202,11 @@ nlohmann::json extreme_result_json(const ExtremeResult& r);
 std::string extremes_csv(const std::vector<ExtremeResult>& results);
 // one scenario's time series, a row per tick: what the observer and the
 // command did (extremes/<name>.csv)
-std::string extreme_series_csv(const std::vector<sim::TraceRow>& rows);
+std::string extreme_series_csv(const std::vector<TickRecord>& rows);
 // E(t) thinned to about `buckets` buckets, each drawn by its lowest and
 // highest point in time order, so that no peak or dip is lost to the
 // thinning (the table's max and min are the curve's)
-EnergyCurve thin_energy(const std::vector<sim::TraceRow>& rows,
+EnergyCurve thin_energy(const std::vector<TickRecord>& rows,
                         std::size_t buckets = 400);
 // the figure: one panel per scenario, E(t) in mJ over the whole run, the
 // end of the script dashed, the rest window the study judges shaded, the

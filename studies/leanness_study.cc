@@ -110,7 +110,7 @@ void run_variant(VariantLoop* v, int ticks) {
   int ncon_max = 0, nefc_max = 0;
 
   loop.reset();
-  TraceRow row;
+  TickRecord row;
   const auto t0 = Clock::now();
   const double cpu0 = thread_cpu_s();
   for (std::size_t k = 0; k < n; ++k) {

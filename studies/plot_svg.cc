@@ -234,13 +234,13 @@ struct Snapshot {
   const char* segment;
   const char* tag;
   const char* what;
-  const TraceRow* row = nullptr;
+  const TickRecord* row = nullptr;
   std::string note;  // why there is no row
 };
 
 // the row nearest the middle of the settled half of `segment`, if the run
 // has one within a servo period of it
-void find_snapshot(const std::vector<TraceRow>& rows, const ClosedLoop& loop,
+void find_snapshot(const std::vector<TickRecord>& rows, const ClosedLoop& loop,
                    Snapshot* s) {
   const ScriptSegment* seg = nullptr;
   for (const ScriptSegment& g : loop.script().segments()) {
@@ -251,8 +251,8 @@ void find_snapshot(const std::vector<TraceRow>& rows, const ClosedLoop& loop,
     return;
   }
   const double mid = 0.5 * (seg->settled_from_s() + seg->t1_s);
-  const TraceRow* best = nullptr;
-  for (const TraceRow& r : rows) {
+  const TickRecord* best = nullptr;
+  for (const TickRecord& r : rows) {
     if (best == nullptr || std::abs(r.t_s - mid) < std::abs(best->t_s - mid)) {
       best = &r;
     }
@@ -277,7 +277,7 @@ struct ViewLayout {
 
 void view_panel(Svg& svg, double ox, double oy, const std::string& name,
                 const Snapshot& snap, const Projection& proj,
-                const std::vector<TraceRow>& rows, const VmParams& vm) {
+                const std::vector<TickRecord>& rows, const VmParams& vm) {
   const std::string tag =
       std::string(snap.tag) + (proj.tag.empty() ? "" : "-" + proj.tag);
   auto u = [&](const Vec3& p) { return proj.a.dot(p); };
@@ -309,7 +309,7 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
     add(vm.pivot_mm - L * n);
   }
   for (std::size_t i : idx) add(rows[i].out.p_rm_mm);
-  const TraceRow* r = snap.row;
+  const TickRecord* r = snap.row;
   if (r != nullptr) {
     const ControlOutput& o = r->out;
     add(o.p_rm_mm);
@@ -478,7 +478,7 @@ struct Series {
   std::string name;
   std::string color;
   std::string dash;  // "" solid
-  std::function<double(const TraceRow&)> value;
+  std::function<double(const TickRecord&)> value;
 };
 
 struct HistoryPanel {
@@ -489,7 +489,7 @@ struct HistoryPanel {
 
 }  // namespace
 
-std::string views_svg(const std::vector<TraceRow>& rows,
+std::string views_svg(const std::vector<TickRecord>& rows,
                       const ClosedLoop& loop) {
   const std::string name = case_name(loop);
   if (rows.empty()) return empty_document(name);
@@ -544,7 +544,7 @@ std::string views_svg(const std::vector<TraceRow>& rows,
   return svg.finish();
 }
 
-std::string history_svg(const std::vector<TraceRow>& rows,
+std::string history_svg(const std::vector<TickRecord>& rows,
                         const ClosedLoop& loop) {
   const std::string name = case_name(loop);
   if (rows.empty()) return empty_document(name);
@@ -560,19 +560,19 @@ std::string history_svg(const std::vector<TraceRow>& rows,
   panels[2].heading = "(c) commanded force, N";
   for (int i = 0; i < 3; ++i) {
     const std::string c = kAxis[i];
-    panels[0].series.push_back({c, kColor[i], "", [i](const TraceRow& r) {
+    panels[0].series.push_back({c, kColor[i], "", [i](const TickRecord& r) {
                                   return r.out.p_rm_mm[i] - r.out.x_v_mm[i];
                                 }});
-    panels[1].series.push_back({c, kColor[i], "", [i](const TraceRow& r) {
+    panels[1].series.push_back({c, kColor[i], "", [i](const TickRecord& r) {
                                   return r.out.p_rm_mm[i] - r.out.x_r_mm[i];
                                 }});
-    panels[2].series.push_back({"F_" + c, kColor[i], "", [i](const TraceRow& r) {
+    panels[2].series.push_back({"F_" + c, kColor[i], "", [i](const TickRecord& r) {
                                   return r.out.force_device_N[i];
                                 }});
   }
   panels[0].series.push_back({"d_path (distance to the path)", "#000", "5 3",
-                              [](const TraceRow& r) { return r.d_path_mm; }});
-  panels[2].series.push_back({"|F|", "#000", "5 3", [](const TraceRow& r) {
+                              [](const TickRecord& r) { return r.d_path_mm; }});
+  panels[2].series.push_back({"|F|", "#000", "5 3", [](const TickRecord& r) {
                                 return r.out.force_device_N.norm();
                               }});
 

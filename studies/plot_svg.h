@@ -41,9 +41,9 @@ inline constexpr double kPlotStylusMm = 15.0;
 // polylines keep at most this many rows, plus the run's last one
 inline constexpr std::size_t kPlotMaxPoints = 2000;
 
-std::string views_svg(const std::vector<sim::TraceRow>& rows,
+std::string views_svg(const std::vector<TickRecord>& rows,
                       const sim::ClosedLoop& loop);
-std::string history_svg(const std::vector<sim::TraceRow>& rows,
+std::string history_svg(const std::vector<TickRecord>& rows,
                         const sim::ClosedLoop& loop);
 
 }  // namespace vmh::studies

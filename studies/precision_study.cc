@@ -92,7 +92,7 @@ Trajectory run_loop(ClosedLoop* loop, int ticks, double min_timing_s,
   }
   tr.substeps = loop->substeps();
 
-  TraceRow row;
+  TickRecord row;
   double spent_s = 0.0;
   double best_s = std::numeric_limits<double>::infinity();
   double best_cpu_s = std::numeric_limits<double>::infinity();

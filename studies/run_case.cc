@@ -15,6 +15,7 @@
 #include "controller/device_frame.h"
 #include "report/output_file.h"
 #include "report/parallel.h"
+#include "runtime/trace_writer.h"
 #include "sim/mujoco_messages.h"
 #include "studies/plot_svg.h"
 
@@ -25,97 +26,19 @@ namespace fs = std::filesystem;
 namespace {
 
 
-void put(std::string* s, double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g,", x);
-  *s += buf;
+// trace.csv's layout for a loop: the controller's columns, the plant's,
+// the script's phases, the simulated device's readings (joints only)
+runtime::TraceLayout trace_layout(const ClosedLoop& loop) {
+  runtime::TraceLayout l;
+  l.controller = true;
+  l.vm_dof = loop.controller().mechanism().dof();
+  l.truth = true;
+  for (const ScriptSegment& seg : loop.script().segments()) {
+    l.phases.push_back(seg.name);
+  }
+  l.present = kStateJoints;
+  return l;
 }
-
-// trace.csv's header line
-std::string trace_header(const ClosedLoop& loop) {
-  const std::vector<std::string> cols =
-      trace_columns(loop.controller().mechanism().dof());
-  std::string s;
-  for (std::size_t i = 0; i < cols.size(); ++i) {
-    s += cols[i] + (i + 1 < cols.size() ? "," : "\n");
-  }
-  return s;
-}
-
-// one row of trace.csv, appended to *out
-void append_trace_row(std::string* out, const TraceRow& r, const ClosedLoop& loop) {
-  std::string& s = *out;
-  const int dof = loop.controller().mechanism().dof();
-  const auto& segs = loop.script().segments();
-  const ControlOutput& o = r.out;
-  put(&s, r.t_s);
-  for (int i = 0; i < 6; ++i) put(&s, r.q_dh[i]);
-  for (int i = 0; i < 3; ++i) put(&s, o.p_rm_mm[i]);
-  for (int i = 0; i < 3; ++i) put(&s, o.axis_rm[i]);
-  for (int i = 0; i < dof; ++i) put(&s, i < o.theta_v.size() ? o.theta_v[i] : 0.0);
-  for (int i = 0; i < dof; ++i) put(&s, i < o.theta_r.size() ? o.theta_r[i] : 0.0);
-  for (int i = 0; i < 3; ++i) put(&s, o.x_v_mm[i]);
-  for (int i = 0; i < 3; ++i) put(&s, o.x_r_mm[i]);
-  for (int i = 0; i < 6; ++i) put(&s, o.e[i]);
-  for (int i = 0; i < 6; ++i) put(&s, o.f_motion[i]);
-  for (int i = 0; i < 3; ++i) put(&s, o.force_device_N[i]);
-  for (int i = 0; i < 3; ++i) put(&s, o.tau_motor_Nm[i]);
-  for (int i = 0; i < 3; ++i) put(&s, r.motor_torque_Nm[i]);
-  for (int i = 0; i < 3; ++i) put(&s, r.hand_target.p_mm[i]);
-  for (int i = 0; i < 3; ++i) put(&s, r.hand_force_N[i]);
-  put(&s, r.d_path_mm);
-  s += std::to_string(o.status) + ",";
-  s += segs[static_cast<std::size_t>(r.segment)].name + "\n";
-}
-
-// trace.csv written as the run goes, a buffer of rows at a time, so that
-// the trace's length is bounded by the disk, not by memory. Every failure
-// (open, write, a full disk, close) throws std::runtime_error naming the
-// file and the OS's reason.
-class TraceWriter {
- public:
-  // writes `path`; errors name `shown` (where the file will be once its set
-  // is in place)
-  TraceWriter(const std::string& path, std::string shown, const ClosedLoop& loop)
-      : path_(std::move(shown)), loop_(loop) {
-    f_ = std::fopen(path.c_str(), "wb");
-    if (!f_) fail();
-    buf_ = trace_header(loop_);
-  }
-  ~TraceWriter() {
-    if (f_) std::fclose(f_);
-  }
-  TraceWriter(const TraceWriter&) = delete;
-  TraceWriter& operator=(const TraceWriter&) = delete;
-
-  void add(const TraceRow& r) {
-    append_trace_row(&buf_, r, loop_);
-    if (buf_.size() >= kFlushBytes) flush();
-  }
-  void close() {
-    flush();
-    std::FILE* f = f_;
-    f_ = nullptr;
-    if (std::fclose(f) != 0) fail();
-  }
-
- private:
-  static constexpr std::size_t kFlushBytes = std::size_t{1} << 18;
-  void flush() {
-    if (!buf_.empty() &&
-        std::fwrite(buf_.data(), 1, buf_.size(), f_) != buf_.size()) {
-      fail();
-    }
-    buf_.clear();
-  }
-  [[noreturn]] void fail() const {
-    throw std::runtime_error(path_ + ": " + std::strerror(errno));
-  }
-  std::string path_;
-  const ClosedLoop& loop_;
-  std::FILE* f_ = nullptr;
-  std::string buf_;
-};
 
 }  // namespace
 
@@ -193,60 +116,10 @@ nlohmann::json metrics_json(const RunMetrics& m) {
           {"max_placement_iterations", m.max_placement_iterations}};
 }
 
-const std::vector<CaseEntry>& thesis_cases() {
-  static const std::vector<CaseEntry> cases = {
-      {"case1", "cases/case1.xml"}, {"case2", "cases/case2.xml"},
-      {"case3", "cases/case3.xml"}, {"case4", "cases/case4.xml"},
-      {"case5", "cases/case5.xml"}, {"case6", "cases/case6.xml"},
-  };
-  return cases;
-}
-
-std::string models_dir() {
-  const char* env = std::getenv("VMH_MODELS_DIR");
-  if (env != nullptr && env[0] != '\0') return env;
-  return VMH_DEFAULT_MODELS_DIR;
-}
-
-std::string resolve_scene(const std::string& case_or_path, std::string* name) {
-  for (const CaseEntry& c : thesis_cases()) {
-    if (case_or_path == c.name) {
-      *name = c.name;
-      return (fs::path(models_dir()) / c.scene).string();
-    }
-  }
-  // without throwing: a symlink loop or a name too long for the file
-  // system is a bad argument (SimError), not a failure; and only a regular
-  // file is a scene (a FIFO would block the loader forever)
-  std::error_code ec;
-  const fs::file_status st = fs::status(case_or_path, ec);
-  if (!ec && fs::is_regular_file(st)) {
-    *name = fs::path(case_or_path).stem().string();
-    return case_or_path;
-  }
-  if (!ec && fs::exists(st)) {
-    throw SimError("'" + case_or_path +
-                   "' is not a regular file (a scene is an MJCF file)");
-  }
-  if (ec && ec != std::errc::no_such_file_or_directory) {
-    throw SimError("'" + case_or_path + "': " + ec.message());
-  }
-  std::string known;
-  for (const CaseEntry& c : thesis_cases()) known += std::string(" ") + c.name;
-  throw SimError("'" + case_or_path +
-                 "' is neither a case (" + known.substr(1) +
-                 ") nor an existing scene file");
-}
-
-double trace_bytes_bound(std::int64_t ticks, std::size_t columns) {
-  // "%.9g," of a negative number with an exponent is 16 bytes at most
-  return static_cast<double>(ticks) * static_cast<double>(columns) * 16.0;
-}
-
 void check_trace_fits(const std::string& dir, std::int64_t ticks,
                       std::size_t columns, std::uintmax_t available_B) {
   // a tenth more for the summary and the figures
-  const double need_B = 1.1 * trace_bytes_bound(ticks, columns);
+  const double need_B = 1.1 * runtime::trace_bytes_bound(ticks, columns);
   if (need_B <= static_cast<double>(available_B)) return;
   char buf[256];
   std::snprintf(buf, sizeof buf,
@@ -257,36 +130,8 @@ void check_trace_fits(const std::string& dir, std::int64_t ticks,
   throw SimError(buf);
 }
 
-std::vector<std::string> trace_columns(int vm_dof) {
-  std::vector<std::string> c = {"t_s"};
-  for (int i = 1; i <= 6; ++i) c.push_back("q" + std::to_string(i) + "_rad");
-  for (const char* a : {"x", "y", "z"}) c.push_back(std::string("p_") + a + "_mm");
-  for (const char* a : {"x", "y", "z"}) c.push_back(std::string("a_") + a);
-  for (const char* v : {"theta_v_", "theta_r_"}) {
-    for (int i = 1; i <= vm_dof; ++i) c.push_back(v + std::to_string(i));
-  }
-  for (const char* v : {"xv_", "xr_"}) {
-    for (const char* a : {"x", "y", "z"}) c.push_back(std::string(v) + a + "_mm");
-  }
-  for (int i = 1; i <= 6; ++i) {
-    c.push_back("e_" + std::to_string(i) + (i <= 3 ? "_mm" : "_rad"));
-  }
-  for (int i = 1; i <= 6; ++i) {
-    c.push_back("f_" + std::to_string(i) + (i <= 3 ? "_N" : "_Nmm"));
-  }
-  for (const char* a : {"x", "y", "z"}) c.push_back(std::string("F_") + a + "_N");
-  for (int i = 1; i <= 3; ++i) c.push_back("tau_" + std::to_string(i) + "_Nm");
-  for (int i = 1; i <= 3; ++i) {
-    c.push_back("tau_applied_" + std::to_string(i) + "_Nm");
-  }
-  for (const char* a : {"x", "y", "z"}) c.push_back(std::string("hand_") + a + "_mm");
-  for (const char* a : {"x", "y", "z"}) {
-    c.push_back(std::string("hand_F_") + a + "_N");
-  }
-  c.push_back("d_path_mm");
-  c.push_back("status");
-  c.push_back("phase");
-  return c;
+std::vector<std::string> trace_columns(const ClosedLoop& loop) {
+  return runtime::trace_columns(trace_layout(loop));
 }
 
 namespace {
@@ -302,8 +147,8 @@ int kept_every(const ClosedLoop& loop) {
 // claims compare with case 2's gains. Every tick goes to `trace` (if set) as
 // it is made; every kept_every()-th is kept and returned, so memory stays
 // flat however long the run.
-std::vector<TraceRow> run_to_end(ClosedLoop* loop, const StopFn& stop,
-                                 TraceWriter* trace = nullptr,
+std::vector<TickRecord> run_to_end(ClosedLoop* loop, const StopFn& stop,
+                                 runtime::TraceWriter* trace = nullptr,
                                  MetricsAccumulator* metrics = nullptr) {
   const int thesis_case = loop->config().thesis_case;
   if (auto ref = reference_params(thesis_case, loop->controller_params())) {
@@ -312,10 +157,10 @@ std::vector<TraceRow> run_to_end(ClosedLoop* loop, const StopFn& stop,
   const int every = kept_every(*loop);
   // with servo jitter the number of ticks is not known ahead: run until the
   // simulated time is up
-  std::vector<TraceRow> rows;
+  std::vector<TickRecord> rows;
   rows.reserve(static_cast<std::size_t>(std::min<std::int64_t>(
       kMaxKeptTicks + 1, loop->ticks_per_run() / every + 1)));
-  TraceRow row;
+  TickRecord row;
   std::int64_t n = 0;
   // a bad physics state (NaN, inf or beyond 1e10, which MuJoCo resets)
   // ends the run at the end of its tick: a failure (exit 1), not a result
@@ -339,8 +184,7 @@ void check_space_for_trace(const std::string& dir, const ClosedLoop& loop) {
   const fs::space_info space =
       fs::space(probe.empty() ? fs::path(".") : probe, ec);
   if (ec) return;  // unknown: the writes themselves will tell
-  check_trace_fits(dir, loop.ticks_per_run(),
-                   trace_columns(loop.controller().mechanism().dof()).size(),
+  check_trace_fits(dir, loop.ticks_per_run(), trace_columns(loop).size(),
                    space.available);
 }
 
@@ -373,18 +217,18 @@ CaseResult run_case(const std::string& name, const std::string& scene,
   // all are written (the previous set, if any, is left whole until then);
   // trace.csv is written into it as the run goes
   std::unique_ptr<report::OutputSet> set;
-  std::unique_ptr<TraceWriter> trace;
+  std::unique_ptr<runtime::TraceWriter> trace;
   if (!out_dir.empty()) {
     check_space_for_trace(out_dir, loop);
     set = std::make_unique<report::OutputSet>((fs::path(out_dir) / name).string());
-    trace = std::make_unique<TraceWriter>(
+    trace = std::make_unique<runtime::TraceWriter>(
         (fs::path(set->temp_dir()) / "trace.csv").string(),
-        (fs::path(out_dir) / name / "trace.csv").string(), loop);
+        (fs::path(out_dir) / name / "trace.csv").string(), trace_layout(loop));
   }
   result.kept_every = kept_every(loop);
   const auto start = std::chrono::steady_clock::now();
   MetricsAccumulator metrics(loop);
-  const std::vector<TraceRow> rows =
+  const std::vector<TickRecord> rows =
       run_to_end(&loop, should_stop, trace.get(), &metrics);
   const auto stop = std::chrono::steady_clock::now();
   if (trace) trace->close();
@@ -405,7 +249,7 @@ CaseResult run_case(const std::string& name, const std::string& scene,
       std::vector<std::string> o = overrides;
       o.insert(o.end(), extra.begin(), extra.end());
       ClosedLoop l(scene, o, omni_model_hook(model_file));
-      const std::vector<TraceRow> r = run_to_end(&l, should_stop);
+      const std::vector<TickRecord> r = run_to_end(&l, should_stop);
       return evaluate_claims(thesis_case, r, l);
     };
     // a side's label from where its start pose is (device frame: x right,

@@ -19,24 +19,10 @@
 
 #include "report/progress.h"
 #include "sim/mujoco_messages.h"
+#include "sim/case_catalogue.h"
 #include "studies/claims.h"
 
 namespace vmh::studies {
-
-// The thesis's six cases, in order: name and scene file under the models
-// directory. Adding a case is one line here and one file in models/cases/.
-struct CaseEntry {
-  const char* name;
-  const char* scene;
-};
-const std::vector<CaseEntry>& thesis_cases();
-
-// The models directory: $VMH_MODELS_DIR if set, else the source tree's.
-std::string models_dir();
-
-// A case name ("case1") to its scene path, or a path to itself. Throws
-// SimError for a name that is neither a known case nor an existing file.
-std::string resolve_scene(const std::string& case_or_path, std::string* name);
 
 struct CaseResult {
   std::string name;
@@ -61,11 +47,8 @@ struct Interrupted : std::runtime_error {
   Interrupted() : std::runtime_error("interrupted") {}
 };
 
-// An upper bound on trace.csv's size for `ticks` rows of `columns` columns
-// (bytes).
-double trace_bytes_bound(std::int64_t ticks, std::size_t columns);
 // Throws SimError naming `dir`, the bytes needed and the bytes available
-// when a trace of `ticks` rows (trace_bytes_bound, and a tenth more for the
+// when a trace of `ticks` rows (runtime::trace_bytes_bound, and a tenth more for the
 // other files) does not fit in `available_B`. run_case calls it with the
 // free space of --out's disk before any simulation.
 void check_trace_fits(const std::string& dir, std::int64_t ticks,
@@ -124,8 +107,9 @@ nlohmann::json mujoco_warnings_json(
     const std::array<std::int64_t, mjNWARNING>& per_step,
     const sim::MujocoWarningTally& messages);
 
-// The trace's column names, in order.
-std::vector<std::string> trace_columns(int vm_dof);
+// trace.csv's column names for a loop, in order (runtime/trace_writer.h
+// writes it, as it writes a session's)
+std::vector<std::string> trace_columns(const sim::ClosedLoop& loop);
 
 }  // namespace vmh::studies
 

@@ -322,7 +322,7 @@ SweepPlan plan_sweep(const SensitivityOptions& options) {
   // each case's nominal values, read from the case as loaded
   for (const std::string& name : options.cases) {
     SweepCase c;
-    c.scene = resolve_scene(name, &c.name);
+    c.scene = sim::resolve_scene(name, &c.name);
     sim::ClosedLoop probe(c.scene, options.overrides);
     c.physics_step_s = probe.model()->opt.timestep;
     for (const SweepParameter& p : plan.parameters) {
@@ -464,7 +464,7 @@ PointResult run_point(const SweepPlan& plan, std::size_t index) {
     if (auto ref = reference_params(thesis_case, loop.controller_params())) {
       loop.set_reference(*ref);
     }
-    std::vector<sim::TraceRow> rows;
+    std::vector<TickRecord> rows;
     rows.reserve(static_cast<std::size_t>(loop.ticks_per_run()));
     while (!loop.finished()) {
       rows.emplace_back();

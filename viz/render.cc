@@ -92,7 +92,7 @@ std::vector<RenderedImage> render(const RenderRequest& req) {
   OverlayOptions opt;
   std::vector<OverlayPrimitive> prims;
   std::vector<RenderedImage> images;
-  sim::TraceRow row;
+  TickRecord row;
   bool ticked = false;
   for (double t : times) {
     // the first tick end at or after t; at t = 0 one tick, so that the

@@ -156,7 +156,7 @@ void Viewer::copy_from_physics() {
     hud_->set_samples(buf.data(), live_plot_n_);
     return;
   }
-  sim::TraceRow row;
+  TickRecord row;
   bool ticked = false;
   int n = 0;
   sim_->copy(d_render_, &row, &ticked, plots_.get(), &n);

@@ -5,7 +5,7 @@
 // Threads. The physics thread (viz/viewer_physics.h) runs ClosedLoop::tick
 // at the servo period in real time, whatever the frame rate. The render
 // thread (the one that built the Viewer and calls frame()) copies what a
-// frame needs from it under a short lock (mj_copyData, the last TraceRow,
+// frame needs from it under a short lock (mj_copyData, the last TickRecord,
 // the plot samples) and draws from its copy. With a live device source
 // (ViewerOptions::live) there is no physics thread: the scene's model is
 // posed from the device's joint readings and the overlay drawn from the

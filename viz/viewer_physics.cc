@@ -64,7 +64,7 @@ void SimThread::record_plot() {
   if (ring_count_ < kPlotSamples) ++ring_count_;
 }
 
-void SimThread::copy(mjData* d, sim::TraceRow* row, bool* ticked,
+void SimThread::copy(mjData* d, TickRecord* row, bool* ticked,
                      std::array<PlotSample, kPlotSamples>* plots, int* n) {
   std::lock_guard<std::mutex> lock(mutex_);
   mj_copyData(d, loop_->model(), loop_->data());
@@ -94,7 +94,7 @@ void SimThread::set_speed(double factor) { speed_ = factor; }
 void SimThread::reset() {
   std::lock_guard<std::mutex> lock(mutex_);
   loop_->reset();
-  row_ = sim::TraceRow{};
+  row_ = TickRecord{};
   ticked_ = false;
   ticks_ = 0;
   ring_head_ = ring_count_ = 0;

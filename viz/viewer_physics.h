@@ -54,7 +54,7 @@ class SimThread {
 
   // What a frame copies: the state into *d (made for model()), the last
   // tick's row, and the plot samples, oldest first, into plots[0..*n).
-  void copy(mjData* d, sim::TraceRow* row, bool* ticked,
+  void copy(mjData* d, TickRecord* row, bool* ticked,
             std::array<PlotSample, kPlotSamples>* plots, int* n);
 
   void set_paused(bool on);
@@ -74,7 +74,7 @@ class SimThread {
 
   std::unique_ptr<sim::ClosedLoop> loop_;
   std::mutex mutex_;  // guards loop_'s state, row_, the plot ring
-  sim::TraceRow row_;
+  TickRecord row_;
   bool ticked_ = false;
   std::array<PlotSample, kPlotSamples> ring_{};
   int ring_head_ = 0, ring_count_ = 0;

@@ -206,10 +206,12 @@ Transport* checked(const std::unique_ptr<Transport>& t) {
 
 FirewireBackend::FirewireBackend(std::unique_ptr<Transport> transport,
                                  const FirewireOmniOptions& options,
-                                 DeviceIdentity identity)
+                                 DeviceIdentity identity,
+                                 LockstepPlant* lockstep)
     : transport_(std::move(transport)),
       omni_(checked(transport_), options),
-      identity_(std::move(identity)) {
+      identity_(std::move(identity)),
+      plant_(lockstep) {
   const NodeInfo n = transport_->node();
   if (identity_.backend.empty()) identity_.backend = "firewire";
   if (identity_.model.empty()) identity_.model = "PHANTOM Omni";
@@ -236,6 +238,23 @@ ServoReport FirewireBackend::start(ServoLoop* loop,
     throw DeviceOpenError("firewire: the servo loop is already running");
   }
   if (thread_) thread_->stop();
+  if (options.lockstep) {
+    if (plant_ == nullptr) {
+      throw DeviceOpenError("firewire: a device on a bus runs on the wall "
+                            "clock; lockstep is for a simulated plant");
+    }
+    if (loop == nullptr) throw DeviceOpenError("firewire: start without a loop");
+    auto driver = std::make_unique<LockstepDriver>(options.period_s);
+    transport_->start();
+    started_ = true;
+    omni_.send_zero();
+    lockstep_ = std::move(driver);
+    lockstep_->start(loop, plant_);
+    ServoReport r;
+    r.note = "lockstep: the loop runs on the caller's thread, one period of "
+             "the simulated plant per tick";
+    return r;
+  }
   // validates before anything is started (std::invalid_argument)
   auto thread = std::make_unique<ServoThread>(loop, options);
   transport_->start();  // throws DeviceOpenError naming the failed step
@@ -253,6 +272,7 @@ ServoReport FirewireBackend::start(ServoLoop* loop,
 
 void FirewireBackend::stop() noexcept {
   if (thread_) thread_->stop();
+  if (lockstep_) lockstep_->stop();
   if (started_) {
     omni_.send_zero();  // the last packet: zero words, motors off
     transport_->stop();
@@ -261,11 +281,21 @@ void FirewireBackend::stop() noexcept {
 }
 
 bool FirewireBackend::running() const noexcept {
+  if (lockstep_) return lockstep_->running();
   return thread_ != nullptr && thread_->running();
 }
 
 TickStats FirewireBackend::timing() const {
+  if (lockstep_) return lockstep_->timing();
   return thread_ ? thread_->timing() : TickStats{};
+}
+
+void FirewireBackend::pass(double dt_s) {
+  if (lockstep_) {
+    lockstep_->pass(dt_s);
+    return;
+  }
+  DeviceBackend::pass(dt_s);
 }
 
 }  // namespace vmh::hw::fw

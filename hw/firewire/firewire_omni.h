@@ -37,6 +37,7 @@
 #include <memory>
 
 #include "device/device_backend.h"
+#include "device/lockstep.h"
 #include "device/haptic_device.h"
 #include "device/seqlock.h"
 #include "hw/firewire/omni_packet.h"
@@ -152,9 +153,14 @@ class FirewireBackend final : public DeviceBackend {
  public:
   // `identity` fills what the transport does not know (backend name,
   // config). Throws std::invalid_argument for bad options.
+  // `lockstep` (not owned; may be null): the simulated plant on the other
+  // end of the transport (the emulator behind the packets), which lets
+  // the loop run in lockstep (ServoOptions::lockstep, device/lockstep.h);
+  // without it a lockstep start is refused.
   FirewireBackend(std::unique_ptr<Transport> transport,
                   const FirewireOmniOptions& options,
-                  DeviceIdentity identity);
+                  DeviceIdentity identity,
+                  LockstepPlant* lockstep = nullptr);
   ~FirewireBackend() override;
 
   DeviceIdentity identity() const override;
@@ -164,6 +170,7 @@ class FirewireBackend final : public DeviceBackend {
   void stop() noexcept override;
   bool running() const noexcept override;
   TickStats timing() const override;
+  void pass(double dt_s) override;
 
   FirewireOmni* omni() noexcept { return &omni_; }
   Transport* transport() noexcept { return transport_.get(); }
@@ -173,6 +180,8 @@ class FirewireBackend final : public DeviceBackend {
   FirewireOmni omni_;
   DeviceIdentity identity_;
   std::unique_ptr<ServoThread> thread_;
+  LockstepPlant* plant_ = nullptr;
+  std::unique_ptr<LockstepDriver> lockstep_;
   bool started_ = false;
 };
 

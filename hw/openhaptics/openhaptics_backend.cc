@@ -344,6 +344,11 @@ ServoReport OpenHapticsBackend::start(ServoLoop* loop,
   }
   if (started_.load()) throw DeviceOpenError("openhaptics: already started");
   if (loop == nullptr) throw DeviceOpenError("openhaptics: start without a loop");
+  if (options.lockstep) {
+    throw DeviceOpenError("openhaptics: the HD scheduler runs on the wall "
+                          "clock; lockstep is for the emulator (--clock "
+                          "realtime)");
+  }
   if (!(std::fabs(options.period_s - 1e-3) <= 1e-9)) {
     throw DeviceOpenError(
         "openhaptics: the HD scheduler runs at 1 kHz; period_s = " +

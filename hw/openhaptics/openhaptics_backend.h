@@ -86,7 +86,8 @@ class OpenHapticsBackend final : public DeviceBackend {
   // hdUpdateCalibration with the style HD_CALIBRATION_STYLE allows (see
   // hd::calibration_style_to_use); throws DeviceOpenError if the device
   // names none or reports an error. Returns the state afterwards.
-  CalibrationState update_calibration();
+  CalibrationState update_calibration() override;
+  bool has_driver_calibration() const override { return true; }
 
   HapticDevice* device() noexcept override { return &device_; }
 

@@ -359,7 +359,7 @@ CompareSection compare_force_direction(const Recording& rec,
   // the emulator's own scene when it says which (never its seeded faults)
   std::string scene = rec.emulator_scene();
   if (scene.empty()) {
-    scene = o.scene.empty() ? studies::models_dir() + "/cases/case1.xml" : o.scene;
+    scene = o.scene.empty() ? sim::models_dir() + "/cases/case1.xml" : o.scene;
   }
   ResponseSimulator sim(scene, o.model_file);
   const ResponseInput in = response_input(w, o);

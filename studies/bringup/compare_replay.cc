@@ -212,7 +212,7 @@ void simulate(const Recording& r, const std::string& scene,
   }
   sim::ClosedLoop loop(scene, overrides);
   Series sim;
-  sim::TraceRow row;
+  TickRecord row;
   while (!loop.finished()) {
     loop.tick(&row);
     sim.t_s.push_back(row.t_s);

@@ -9,7 +9,8 @@ namespace vmh::bringup {
 namespace {
 
 bool is_text_column(const std::string& name) {
-  return name == "read_error" || name == "write_error" || name == "safety_flags";
+  return name == "read_error" || name == "write_error" ||
+         name == "safety_flags" || name == "phase";
 }
 
 std::vector<std::string> split(const std::string& line) {

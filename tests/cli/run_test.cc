@@ -48,7 +48,7 @@ TEST(RunCli, WritesTraceAndSummary) {
 
   // the documented columns, in order (docs/outputs.md, "trace.csv")
   const std::string header = first_line(out / "case1" / "trace.csv");
-  EXPECT_EQ(header.rfind("t_s,q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad,"
+  EXPECT_EQ(header.rfind("t_s,period_s,q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad,"
                          "p_x_mm,p_y_mm,p_z_mm,a_x,a_y,a_z,theta_v_1,"
                          "theta_r_1,xv_x_mm,xv_y_mm,xv_z_mm,xr_x_mm,",
                          0),

@@ -32,7 +32,7 @@ using CaseTest = testing::ThesisCaseTest;
 // zero, no warning callback), finite state, and no controller fault.
 TEST_P(CaseTest, RunsWithoutWarningOrFault) {
   ClosedLoop loop(scene(GetParam()), {});
-  TraceRow row;
+  TickRecord row;
   int faults = 0;
   for (int k = 0; k < loop.ticks_per_run(); ++k) {
     loop.tick(&row);
@@ -58,7 +58,7 @@ TEST(ClosedLoopTest, TorqueIsHeldOverTheServoPeriod) {
   testing::MujocoGuard guard;
   ClosedLoop loop(scene(1), {"physics_step_s=0.0002"});
   ASSERT_EQ(loop.substeps(), 5);
-  TraceRow row;
+  TickRecord row;
   // let the hand pull the RM off the path so that the torque is non-zero
   for (int k = 0; k < 1500; ++k) loop.tick(&row);
   ASSERT_GT(row.motor_torque_Nm.norm(), 1e-3);
@@ -86,7 +86,7 @@ TEST(ClosedLoopTest, TorqueLimitsReachTheSimulatedMotors) {
     EXPECT_EQ(lim, expect) << which;
     const mjModel* m = loop.model();
     double largest = 0.0;
-    TraceRow row;
+    TickRecord row;
     for (int k = 0; k < loop.ticks_per_run(); ++k) {
       loop.tick(&row);
       largest = std::max(largest, row.motor_torque_Nm.cwiseAbs().maxCoeff());
@@ -109,7 +109,7 @@ TEST(ClosedLoopTest, TorqueLimitsReachTheSimulatedMotors) {
 TEST(ClosedLoopTest, DelayShiftsTheTorqueByWholeTicks) {
   testing::MujocoGuard guard;
   ClosedLoop loop(scene(2), {"delay_ticks=1"});
-  TraceRow prev, row;
+  TickRecord prev, row;
   loop.tick(&prev);
   for (int k = 0; k < 2000; ++k) {
     loop.tick(&row);
@@ -147,7 +147,7 @@ TEST(ClosedLoopTest, SensorModelSitsBetweenTruthAndController) {
   testing::MujocoGuard guard;
   for (const char* q : {"quantize=1", "quantize=0"}) {
     ClosedLoop loop(scene(1), {q});
-    TraceRow row;
+    TickRecord row;
     double worst = 0.0;
     for (int k = 0; k < 3000; ++k) {
       loop.tick(&row);
@@ -210,7 +210,7 @@ TEST(ClosedLoopTest, PlainMjStepGivesTheSameTrajectory) {
   ASSERT_EQ(registered_hand(bare.get()), nullptr);
   ASSERT_EQ(registered_hand(d), &plain.hand());
 
-  TraceRow row;
+  TickRecord row;
   double max_bare_gap = 0.0;
   for (int k = 0; k < 400; ++k) {
     const double t_s = looped.time_s();
@@ -257,7 +257,7 @@ TEST(ClosedLoopTest, TheHandIsRegisteredForItsDataOnly) {
 TEST(ClosedLoopTest, ManualTargetPullsTheGrip) {
   testing::MujocoGuard guard;
   ClosedLoop loop(scene(1), {"k_pos_N_per_mm=0", "k_ornt_multiple=0"});
-  TraceRow row;
+  TickRecord row;
   for (int k = 0; k < 50; ++k) loop.tick(&row);
   EXPECT_FALSE(loop.manual_hand());
   // off: the row's target is the script's, and the manual one starts from
@@ -386,7 +386,7 @@ TEST(ClosedLoopPhysics, TheFirstBadStateIsKeptAndEveryWarningCounted) {
   ClosedLoop loop(scene(1), {"hand_k_pos_N_per_m=1e30"});
   EXPECT_FALSE(loop.physics_fault().has_value());
   EXPECT_NO_THROW(loop.throw_if_physics_fault());
-  TraceRow row;
+  TickRecord row;
   loop.tick(&row);
   ASSERT_TRUE(loop.physics_fault().has_value());
   const PhysicsFault first = *loop.physics_fault();

@@ -144,7 +144,7 @@ TEST(EmulatorKinematics, EveryReadingReportsTheTrueKinematics) {
     EXPECT_TRUE(s.has(kStateTransform) && s.has(kStateVelocity) &&
                 s.has(kStateJacobian));
     const OmniParams& p = emu.loop().controller_params().omni;
-    const OmniPose pose = omni_fk(p, t.q_true_dh);
+    const OmniPose pose = omni_fk(p, t.q_end_dh);
     EXPECT_LE((s.transform_mm.topRightCorner<3, 1>() -
                base_to_device_mm(p, pose.p_base_m)).cwiseAbs().maxCoeff(), 1e-9);
     EXPECT_LE((s.transform_mm.col(2).head<3>() - t.stylus_axis).cwiseAbs().maxCoeff(),

@@ -72,7 +72,7 @@ class Rig {
   SafetyStatus status() const { return status_.load(); }
   bool has(SafetyStatus f) const { return (status() & f) != 0; }
   Vec3 held() const { return emu_.truth().motor_torque_Nm; }
-  Joints q_dh() const { return emu_.truth().q_true_dh; }
+  Joints q_dh() const { return emu_.truth().q_end_dh; }
   bool wait_flag(SafetyStatus f, bool set, double limit_s) {
     return wait_for([&] { return has(f) == set; }, limit_s);
   }

@@ -132,7 +132,7 @@ TEST(SeededFaults, SignAndSwapChangeOnlyTheReportedAngles) {
   EmulatorTruth t;
   ASSERT_TRUE(matched_reading(&emu, &s, &t));
   const OmniParams& p = emu.loop().controller_params().omni;
-  const Joints meas = SensorModel(p, true).measure(dh_to_device_joints(t.q_true_dh));
+  const Joints meas = SensorModel(p, true).measure(dh_to_device_joints(t.q_end_dh));
   EXPECT_NEAR(s.q_device_rad[0], -meas[0], 1e-12);
   EXPECT_NEAR(s.q_device_rad[4], meas[5], 1e-12);
   EXPECT_NEAR(s.q_device_rad[5], meas[4], 1e-12);
@@ -143,7 +143,7 @@ TEST(SeededFaults, SignAndSwapChangeOnlyTheReportedAngles) {
   const Joints raw = hw::angles_from_raw(s.encoder_counts, s.gimbal_pots,
                                          emu.factory_calibration());
   for (int i = 0; i < 6; ++i) EXPECT_NEAR(raw[i], meas[i], 1e-12) << i;
-  EXPECT_LE((s.transform_mm.topRightCorner<3, 1>() - t.p_true_mm).cwiseAbs().maxCoeff(),
+  EXPECT_LE((s.transform_mm.topRightCorner<3, 1>() - t.p_end_mm).cwiseAbs().maxCoeff(),
             1e-9);
   emu.stop();
 }
@@ -170,9 +170,9 @@ TEST(SeededFaults, DelayDeliversReadingsFivePeriodsOld) {
     // just after the reading of the same period
     const long age = r.periods_before - it->periods;
     EXPECT_TRUE(age == 5 || age == 4) << age;
-    const Joints meas = sensor.measure(dh_to_device_joints(it->q_true_dh));
+    const Joints meas = sensor.measure(dh_to_device_joints(it->q_end_dh));
     EXPECT_LE((r.state.q_device_rad - meas).cwiseAbs().maxCoeff(), 1e-12);
-    EXPECT_LE((r.state.transform_mm.topRightCorner<3, 1>() - it->p_true_mm)
+    EXPECT_LE((r.state.transform_mm.topRightCorner<3, 1>() - it->p_end_mm)
                   .cwiseAbs().maxCoeff(), 1e-9);
     checked += age == 5 ? 1 : 0;
   }
@@ -223,10 +223,10 @@ TEST(SeededFaults, LongerLinkMovesTheReportedTransform) {
   OmniParams longer = nominal;
   longer.l1_m *= 1.02;
   const Vec3 p = s.transform_mm.topRightCorner<3, 1>();
-  EXPECT_LE((p - base_to_device_mm(nominal, omni_fk(longer, t.q_true_dh).p_base_m))
+  EXPECT_LE((p - base_to_device_mm(nominal, omni_fk(longer, t.q_end_dh).p_base_m))
                 .cwiseAbs().maxCoeff(), 1e-9);
   // 2 % of 133 mm: the nominal FK is millimetres off
-  EXPECT_GT((p - base_to_device_mm(nominal, omni_fk(nominal, t.q_true_dh).p_base_m))
+  EXPECT_GT((p - base_to_device_mm(nominal, omni_fk(nominal, t.q_end_dh).p_base_m))
                 .norm(), 2.0);
 }
 

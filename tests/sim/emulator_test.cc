@@ -282,7 +282,7 @@ TEST(Emulator, DockProgramReachesTheInkwell) {
   for (int i = 0; i < 6; ++i) ink[i] = kInkwellDevice_rad[i];
   const Vec3 ink_mm =
       base_to_device_mm(omni, omni_fk(omni, device_to_dh_joints(ink)).p_base_m);
-  EXPECT_LT((emu.truth().p_true_mm - ink_mm).norm(), kDockRadius_mm);
+  EXPECT_LT((emu.truth().p_end_mm - ink_mm).norm(), kDockRadius_mm);
   // the inkwell is where docs/omni.md puts it (OpenHaptics's dock point)
   EXPECT_NEAR(ink_mm.y(), -65.51, 1.0);
   EXPECT_NEAR(ink_mm.z(), -88.11, 1.0);
@@ -351,7 +351,7 @@ TEST(Emulator, RawReadingsDecodeToTheReportedAngles) {
   }
   // and the angles are SimDevice's: the sensor model on the true angles
   const SensorModel sensor(emu.loop().controller_params().omni, true);
-  const Joints expect = sensor.measure(dh_to_device_joints(t.q_true_dh));
+  const Joints expect = sensor.measure(dh_to_device_joints(t.q_end_dh));
   for (int i = 0; i < 6; ++i) EXPECT_NEAR(s.q_device_rad[i], expect[i], 1e-12) << i;
   // the factory calibration has offsets (it is not the identity)
   EXPECT_GT(std::abs(f.encoder_offset_rad[0]), 0.1);

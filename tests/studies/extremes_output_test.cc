@@ -17,8 +17,8 @@ namespace vmh::studies {
 namespace {
 
 // rows at 1 ms with a wavy observer and one sharp spike and dip
-std::vector<sim::TraceRow> wavy_rows(std::size_t n) {
-  std::vector<sim::TraceRow> rows(n);
+std::vector<TickRecord> wavy_rows(std::size_t n) {
+  std::vector<TickRecord> rows(n);
   for (std::size_t k = 0; k < n; ++k) {
     rows[k].t_s = 1e-3 * static_cast<double>(k + 1);
     rows[k].energy_motor_J = 1e-3 * std::sin(0.05 * static_cast<double>(k));
@@ -29,7 +29,7 @@ std::vector<sim::TraceRow> wavy_rows(std::size_t n) {
 }
 
 TEST(ThinEnergy, KeepsEveryBucketsLowestAndHighestInTimeOrder) {
-  const std::vector<sim::TraceRow> rows = wavy_rows(1000);
+  const std::vector<TickRecord> rows = wavy_rows(1000);
   const EnergyCurve e = thin_energy(rows, 100);  // buckets of 10 rows
   ASSERT_EQ(e.t_s.size(), e.energy_J.size());
   EXPECT_LE(e.t_s.size(), 200u);
@@ -50,7 +50,7 @@ TEST(ThinEnergy, KeepsEveryBucketsLowestAndHighestInTimeOrder) {
   EXPECT_EQ(*std::max_element(e.energy_J.begin(), e.energy_J.end()), 5e-3);
   EXPECT_EQ(*std::min_element(e.energy_J.begin(), e.energy_J.end()), -4e-3);
   // fewer rows than buckets: every row
-  const std::vector<sim::TraceRow> few(rows.begin(), rows.begin() + 50);
+  const std::vector<TickRecord> few(rows.begin(), rows.begin() + 50);
   EXPECT_EQ(thin_energy(few, 400).t_s.size(), 50u);
 }
 

@@ -146,12 +146,12 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(ExtremeFaults, NanZeroesTheTorqueFromTheFaultOn) {
   testing::MujocoGuard guard;
   for (const char* name : {"fault_nan", "fault_nan_unguarded"}) {
-    std::vector<TraceRow> rows;
+    std::vector<TickRecord> rows;
     const ExtremeResult r = run_extreme(scenario_named(name), &rows);
     ASSERT_GE(r.fault_tick, 0) << name;
     EXPECT_EQ(r.detection_tick, r.fault_tick) << name;
     for (std::size_t k = static_cast<std::size_t>(r.fault_tick); k < rows.size(); ++k) {
-      const TraceRow& row = rows[k];
+      const TickRecord& row = rows[k];
       ASSERT_TRUE(row.servo.zeroed) << name << " tick " << k;
       ASSERT_EQ(row.motor_torque_Nm, Vec3::Zero()) << name << " tick " << k;
       if (std::string(name) == "fault_nan") {
@@ -170,7 +170,7 @@ TEST(ExtremeFaults, NanZeroesTheTorqueFromTheFaultOn) {
 
 TEST(ExtremeFaults, JumpIsDetectedWithinOneTickAndLatches) {
   testing::MujocoGuard guard;
-  std::vector<TraceRow> rows;
+  std::vector<TickRecord> rows;
   const ExtremeResult r = run_extreme(scenario_named("fault_jump"), &rows);
   ASSERT_GE(r.fault_tick, 0);
   ASSERT_GE(r.detection_tick, 0);
@@ -190,7 +190,7 @@ TEST(ExtremeFaults, JumpIsDetectedWithinOneTickAndLatches) {
 // it, and the loop stays bounded (the VM pushes at a fixed error, saturated).
 TEST(ExtremeFaults, StuckEncoderGoesUnseenButStaysBounded) {
   testing::MujocoGuard guard;
-  std::vector<TraceRow> rows;
+  std::vector<TickRecord> rows;
   const ExtremeResult r = run_extreme(scenario_named("fault_stuck"), &rows);
   ASSERT_GE(r.fault_tick, 0);
   const std::size_t f = static_cast<std::size_t>(r.fault_tick);
@@ -217,7 +217,7 @@ TEST(ServoJitter, PeriodsLieInTheRangeAndTheClockAddsUp) {
   const double h = loop.model()->opt.timestep;
   ASSERT_EQ(loop.substeps_min(), 2);   // 0.4 ms / 0.2 ms
   ASSERT_EQ(loop.substeps_max(), 14);  // 2.8 ms / 0.2 ms
-  TraceRow row;
+  TickRecord row;
   double t_sum = 0.0;
   long steps = 0;
   std::set<int> seen;
@@ -252,7 +252,7 @@ TEST(ServoJitter, TheSeedFixesTheDraws) {
                                      "physics_step_s=0.0002", "duration_s=0.2",
                                      std::string("jitter_seed=") + seed});
     std::vector<int> n;
-    TraceRow row;
+    TickRecord row;
     while (!loop.finished()) {
       loop.tick(&row);
       n.push_back(row.substeps);
@@ -271,7 +271,7 @@ TEST(ServoJitter, OffKeepsTheFixedPeriod) {
   testing::MujocoGuard guard;
   ClosedLoop loop(scene("case1"), {"duration_s=0.1"});
   EXPECT_FALSE(loop.jitter());
-  TraceRow row;
+  TickRecord row;
   int k = 0;
   while (!loop.finished()) {
     loop.tick(&row);
@@ -305,7 +305,7 @@ TEST(PassivityObserver, IsTheWorkOfTheHeldTorquesAlongTheTrueMotion) {
   testing::MujocoGuard guard;
   for (const char* integrator : {"euler", "rk4"}) {
     ClosedLoop loop(scene("case2"), {"duration_s=3", std::string("integrator=") + integrator});
-    std::vector<TraceRow> rows;
+    std::vector<TickRecord> rows;
     while (!loop.finished()) {
       rows.emplace_back();
       loop.tick(&rows.back());
@@ -335,7 +335,7 @@ TEST(PassivityObserver, ReadsZeroWithTheControllerOff) {
   testing::MujocoGuard guard;
   ClosedLoop loop(scene("case2"),
                   {"duration_s=1", "k_pos_N_per_mm=0", "k_ornt_multiple=0"});
-  TraceRow row;
+  TickRecord row;
   double hand = 0.0;
   while (!loop.finished()) {
     loop.tick(&row);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/trace_writer.h"
 #include "studies/run_case.h"
 #include "tests/support/svg_check.h"
 
@@ -119,7 +120,12 @@ TEST(ForceFieldSvgTest, NoRowsGivesADocumentSayingSo) {
 
 TEST(ForceFieldSvgTest, ReadsTheTraceColumnsByName) {
   // trace.csv's own header (one VM joint), two rows with marked values
-  const std::vector<std::string> cols = trace_columns(1);
+  runtime::TraceLayout layout;
+  layout.controller = true;
+  layout.vm_dof = 1;
+  layout.truth = true;
+  layout.phases = {"settle"};
+  const std::vector<std::string> cols = runtime::trace_columns(layout);
   std::string csv;
   for (std::size_t i = 0; i < cols.size(); ++i) {
     csv += cols[i] + (i + 1 < cols.size() ? "," : "\n");

@@ -38,7 +38,7 @@ std::string scene(int n) {
 
 struct CaseRun {
   std::unique_ptr<ClosedLoop> loop;
-  std::vector<TraceRow> rows;
+  std::vector<TickRecord> rows;
   std::string views, history;
 };
 
@@ -52,7 +52,7 @@ const CaseRun& run(int n) {
     r->loop = std::make_unique<ClosedLoop>(
         scene(n), std::vector<std::string>{"duration_s=20"});
     r->rows.resize(static_cast<std::size_t>(r->loop->ticks_per_run()));
-    for (TraceRow& row : r->rows) r->loop->tick(&row);
+    for (TickRecord& row : r->rows) r->loop->tick(&row);
     r->views = views_svg(r->rows, *r->loop);
     r->history = history_svg(r->rows, *r->loop);
     if (const char* dir = std::getenv("VMH_PLOT_SVG_DIR")) {
@@ -67,7 +67,7 @@ const CaseRun& run(int n) {
 
 // The row the views should show for `segment`: nearest the middle of its
 // settled half (first of equals).
-const TraceRow& snapshot_row(const CaseRun& r, const std::string& segment) {
+const TickRecord& snapshot_row(const CaseRun& r, const std::string& segment) {
   const ScriptSegment* seg = nullptr;
   for (const ScriptSegment& s : r.loop->script().segments()) {
     if (s.name == segment) seg = &s;
@@ -142,7 +142,7 @@ TEST(PlotSvgTest, ViewTitlesNameTheSnapshotTimes) {
          std::vector<std::pair<std::string, std::string>>{
              {"off_out_misaligned", "RM off the path"},
              {"on_misaligned_a", "RM on the path"}}) {
-      const TraceRow& row = snapshot_row(r, segment);
+      const TickRecord& row = snapshot_row(r, segment);
       EXPECT_EQ(r.loop->script().segments()[static_cast<std::size_t>(row.segment)].name,
                 segment);
       char t[64];
@@ -184,7 +184,7 @@ TEST(PlotSvgTest, ForceArrowIsTheForceTimesTheScale) {
   for (const auto& [tag, segment] : std::vector<std::pair<std::string, std::string>>{
            {"off", "off_out_misaligned"}, {"on", "on_misaligned_a"}}) {
     SCOPED_TRACE(tag);
-    const TraceRow& row = snapshot_row(r, segment);
+    const TickRecord& row = snapshot_row(r, segment);
     const auto path = element(r.views, "path-" + tag);
     const auto shaft = element(r.views, "force-" + tag);
     ASSERT_FALSE(path.empty());

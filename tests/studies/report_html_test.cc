@@ -146,9 +146,9 @@ TEST(ReportHtmlTest, RealRunsOfTheSixCasesAreAllOnThePage) {
   const fs::path dir = fs::path(::testing::TempDir()) / "vmh_report_html_cases";
   fs::remove_all(dir);
   std::vector<CaseJob> jobs;
-  for (const CaseEntry& c : thesis_cases()) {
+  for (const sim::CaseEntry& c : sim::thesis_cases()) {
     std::string name;
-    jobs.push_back({c.name, resolve_scene(c.name, &name), {}, {}, false});
+    jobs.push_back({c.name, sim::resolve_scene(c.name, &name), {}, {}, false});
   }
   // the progress callback, called from the two workers, ends at 6 of 6
   std::atomic<std::size_t> last_done{0}, calls{0};

@@ -1,6 +1,7 @@
 // studies/run_case.h: one case run to its end. What `run` writes is checked
 // by tests/cli/run_test.cc; here, what the library does with MuJoCo's
 // warnings and with a physics state gone bad.
+#include "runtime/trace_writer.h"
 #include "studies/run_case.h"
 
 #include <gtest/gtest.h>
@@ -115,7 +116,7 @@ TEST(RunCase, AShortRunKeepsEveryTick) {
 // The space check before any simulation: a bound on trace.csv's size (16
 // bytes a column) and a tenth more, against what the disk has.
 TEST(TraceFits, RefusesATraceTheDiskCannotHoldNamingBoth) {
-  EXPECT_DOUBLE_EQ(trace_bytes_bound(20000, 55), 20000.0 * 55 * 16);
+  EXPECT_DOUBLE_EQ(runtime::trace_bytes_bound(20000, 55), 20000.0 * 55 * 16);
   EXPECT_NO_THROW(check_trace_fits("out", 20000, 55, 20000u * 55u * 16u * 2u));
   try {
     check_trace_fits("/full/disk", 3600000, 55, 1000000000u);

@@ -151,7 +151,7 @@ Pixel project(const mjvScene& scn, int w, int h, const Vec3& p) {
 
 TEST(SceneRenderer, ForceArrowIsDrawnWhereItProjects) {
   vmh::sim::ClosedLoop loop(kCase1, {});
-  vmh::sim::TraceRow row;
+  vmh::TickRecord row;
   while (loop.time_s() < kPullTime_s - 1e-9) loop.tick(&row);
   const double f_N = row.out.force_device_N.norm();
   ASSERT_GT(f_N, 1.0) << "case1 should push back hard at " << kPullTime_s;

@@ -304,7 +304,7 @@ Recording run_with_jacobian(double column1_sign) {
   r.dir = "synthetic-run";
   r.verb = "hw run";
   r.meta = {{"verb", r.verb}};
-  sim::TraceRow row;
+  TickRecord row;
   for (int k = 0; k < 3000; ++k) {
     loop.tick(&row);
     const Joints t = dh_to_device_joints(row.q_dh);

@@ -38,7 +38,7 @@ Recording run_recording(const std::vector<std::string>& overrides,
   r.verb = "hw run";
   r.meta = {{"verb", r.verb}, {"case", "case1"}, {"scene", kScene}};
   const char* xyz[] = {"x", "y", "z"};
-  sim::TraceRow row;
+  TickRecord row;
   while (!loop.finished()) {
     loop.tick(&row);
     const bool ok = row.servo.read == DeviceError::kOk;

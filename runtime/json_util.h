@@ -1,13 +1,13 @@
 // Eigen values as JSON arrays: vectors as lists, matrices as lists of rows;
 // the time stamp the outputs carry.
-#ifndef VMHAPTICS_CLI_JSON_UTIL_H_
-#define VMHAPTICS_CLI_JSON_UTIL_H_
+#ifndef VMHAPTICS_RUNTIME_JSON_UTIL_H_
+#define VMHAPTICS_RUNTIME_JSON_UTIL_H_
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 #include <string>
 
-namespace vmh::cli {
+namespace vmh {
 
 // keys stay in the order the program writes them
 using Json = nlohmann::ordered_json;
@@ -39,6 +39,6 @@ Json to_json_rows(const Eigen::MatrixBase<Derived>& m) {
   return out;
 }
 
-}  // namespace vmh::cli
+}  // namespace vmh
 
-#endif  // VMHAPTICS_CLI_JSON_UTIL_H_
+#endif  // VMHAPTICS_RUNTIME_JSON_UTIL_H_

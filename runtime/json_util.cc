@@ -1,8 +1,8 @@
-#include "cli/json_util.h"
+#include "runtime/json_util.h"
 
 #include <ctime>
 
-namespace vmh::cli {
+namespace vmh {
 
 namespace {
 
@@ -71,4 +71,4 @@ std::string utc_now() {
   return buf;
 }
 
-}  // namespace vmh::cli
+}  // namespace vmh
