@@ -159,7 +159,8 @@ inline constexpr int kMaxLatePeriods = 63;
 // host's view of it) for the whole session, for bring-up's `compare` to
 // find. Hidden: nothing a session writes to its trace carries them; meta.json
 // records them only under "emulator" (the emulator's setup, for tests).
-// Text form (parse_seeded_faults), comma-separated, combinable:
+// Text form (parse_seeded_faults; the names are the seeded kinds of
+// sim/fault_vocabulary.h's table), comma-separated, combinable:
 //   joint<N>_sign       N = 1..6: the reported t_N is negated after decoding
 //                       (a sign mistake in the host's codec or wiring); the
 //                       raw encoder counts and pot codes and the device's own
@@ -200,8 +201,9 @@ void apply_seeded_readings(const SeededFaults& seeded,
                            Joints* q_device_rad) noexcept;
 
 // "drop@1.0:5,late@2.0:0.5:3,stall@3:0.2,unplug@4:1": kind@at_s then
-// drop:count, late:duration_s:count, stall:duration_s, unplug:duration_s.
-// Empty text: no faults. Throws std::invalid_argument naming the bad item.
+// drop:count, late:duration_s:count, stall:duration_s, unplug:duration_s
+// (the one fault grammar and table: sim/fault_vocabulary.h). Empty text:
+// no faults. Throws std::invalid_argument naming the bad item.
 std::vector<EmulatorFault> parse_emulator_faults(const std::string& text);
 // Throws std::invalid_argument naming the fault's bad field.
 void validate_emulator_fault(const EmulatorFault& fault);

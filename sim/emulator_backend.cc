@@ -12,6 +12,7 @@
 #include "sim/closed_loop.h"
 #include "sim/emulator.h"
 #include "sim/emulator_firewire.h"
+#include "sim/fault_vocabulary.h"
 
 namespace vmh::sim {
 namespace {
@@ -323,19 +324,18 @@ OpenedDevice open_emulator_firewire(const OpenRequest& rq) {
 }
 
 const std::vector<runtime::BackendOption>& emulator_option_list() {
+  // the faults' help comes from the one fault table (sim/fault_vocabulary.h)
   static const std::vector<runtime::BackendOption> options = {
       {"hand",
        "what holds the emulated stylus: case, tour, none, dock, gimbal_sweep "
        "(default depends on the verb)"},
       {"fault",
-       "injected faults: emulator: drop@1.0:5,late@2:0.5:3,stall@3:0.2,"
-       "unplug@4:1; emulator:firewire (packets): loss@1:5,late@2:0.5:3,"
-       "length@3:2,reset@4,unplug@5:1,stall@6:0.2"},
+       "injected faults, comma-separated kind@t[:...] (t: emulator time, s). "
+       "emulator: " + fault_help(kTransportFaults) +
+           ". emulator:firewire (packets): " + fault_help(kWireFaults)},
       {"emulator-fault",
-       "seeded faults for bring-up tests, comma-separated: joint<N>_sign, "
-       "gimbal_swap, link_length_<P>pct, delay_<M>ms, motor3_relative, "
-       "motor<N>_sign, torque_units_Nm, torque_units_mNm, mass_x<K>, "
-       "friction_x<K>, damping_x<K> (docs/hardware.md)"},
+       "seeded faults for bring-up tests, comma-separated: " +
+           fault_help(kSeededFaults) + " (docs/hardware.md)"},
       {"model",
        "a calibrated Omni MJCF (e.g. models/omni/calibrated/<serial>.xml) "
        "whose parameters replace the scene's Omni's"},

@@ -1,4 +1,5 @@
-// The emulator's names and the fault list's text form (sim/emulator.h).
+// The emulator's hand programs' names, and its transport faults from
+// their text form (sim/fault_vocabulary.h parses it).
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
@@ -6,6 +7,7 @@
 #include <vector>
 
 #include "sim/emulator.h"
+#include "sim/fault_vocabulary.h"
 
 namespace vmh::sim {
 namespace {
@@ -21,32 +23,6 @@ constexpr ProgramName kPrograms[] = {
     {HandProgram::kDock, "dock"},
     {HandProgram::kGimbalSweep, "gimbal_sweep"},
 };
-
-double number(const std::string& text, const std::string& item,
-              const char* what) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
-    throw std::invalid_argument("emulator fault '" + item + "': " + what +
-                                " '" + text + "' is not a number");
-  }
-  return v;
-}
-
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : s) {
-    if (c == sep) {
-      out.push_back(cur);
-      cur.clear();
-    } else if (c != ' ') {
-      cur += c;
-    }
-  }
-  out.push_back(cur);
-  return out;
-}
 
 }  // namespace
 
@@ -107,66 +83,30 @@ void validate_emulator_fault(const EmulatorFault& f) {
 
 std::vector<EmulatorFault> parse_emulator_faults(const std::string& text) {
   std::vector<EmulatorFault> out;
-  if (text.find_first_not_of(' ') == std::string::npos) return out;
-  for (const std::string& item : split(text, ',')) {
-    const auto at = item.find('@');
-    if (at == std::string::npos) {
-      throw std::invalid_argument("emulator fault '" + item +
-                                  "': expected kind@at_s[:...]");
-    }
-    const std::string kind = item.substr(0, at);
-    const std::vector<std::string> f = split(item.substr(at + 1), ':');
-    EmulatorFault fault;
-    std::size_t want = 0;
+  for (const FaultItem& it : parse_faults(text, kTransportFaults)) {
+    EmulatorFault f;
+    const std::string kind = it.kind->name;
+    f.at_s = it.at_s;
     if (kind == "drop") {
-      fault.kind = EmulatorFaultKind::kDrop;
-      want = 2;
+      f.kind = EmulatorFaultKind::kDrop;
+      f.count = static_cast<int>(it.values[0]);
     } else if (kind == "late") {
-      fault.kind = EmulatorFaultKind::kLate;
-      want = 3;
+      f.kind = EmulatorFaultKind::kLate;
+      f.duration_s = it.values[0];
+      f.count = static_cast<int>(it.values[1]);
     } else if (kind == "stall") {
-      fault.kind = EmulatorFaultKind::kStall;
-      want = 2;
-    } else if (kind == "unplug") {
-      fault.kind = EmulatorFaultKind::kUnplug;
-      want = 2;
-    } else {
-      throw std::invalid_argument("emulator fault '" + item + "': unknown kind '" +
-                                  kind + "' (drop, late, stall, unplug)");
-    }
-    if (f.size() != want) {
-      throw std::invalid_argument(
-          "emulator fault '" + item + "': " + kind + " takes " +
-          (kind == "drop"   ? "at_s:count"
-           : kind == "late" ? "at_s:duration_s:count"
-                            : "at_s:duration_s"));
-    }
-    fault.at_s = number(f[0], item, "at_s");
-    if (fault.kind == EmulatorFaultKind::kDrop) {
-      const double c = number(f[1], item, "count");
-      if (c != std::floor(c) || c < 1 || c > 1e6) {
-        throw std::invalid_argument("emulator fault '" + item +
-                                    "': count must be a whole number >= 1");
-      }
-      fault.count = static_cast<int>(c);
-    } else {
-      fault.duration_s = number(f[1], item, "duration_s");
-    }
-    if (fault.kind == EmulatorFaultKind::kLate) {
-      const double c = number(f[2], item, "count");
-      if (c != std::floor(c) || c < 1 || c > kMaxLatePeriods) {
-        throw std::invalid_argument("emulator fault '" + item +
-                                    "': count must be a whole number in [1, " +
-                                    std::to_string(kMaxLatePeriods) + "]");
-      }
-      fault.count = static_cast<int>(c);
+      f.kind = EmulatorFaultKind::kStall;
+      f.duration_s = it.values[0];
+    } else {  // the table's last transport kind
+      f.kind = EmulatorFaultKind::kUnplug;
+      f.duration_s = it.values[0];
     }
     try {
-      validate_emulator_fault(fault);
+      validate_emulator_fault(f);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument("emulator fault '" + item + "': " + e.what());
+      throw std::invalid_argument("emulator fault '" + it.text + "': " + e.what());
     }
-    out.push_back(fault);
+    out.push_back(f);
   }
   return out;
 }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "device/tick_timer.h"
+#include "sim/fault_vocabulary.h"
 
 namespace vmh::sim {
 namespace {
@@ -24,40 +25,6 @@ constexpr KindName kKinds[] = {
     {WireFaultKind::kLength, "length"}, {WireFaultKind::kReset, "reset"},
     {WireFaultKind::kUnplug, "unplug"}, {WireFaultKind::kStall, "stall"},
 };
-
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : s) {
-    if (c == sep) {
-      out.push_back(cur);
-      cur.clear();
-    } else if (c != ' ') {
-      cur += c;
-    }
-  }
-  out.push_back(cur);
-  return out;
-}
-
-double number(const std::string& text, const std::string& item, const char* what) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
-    throw std::invalid_argument("firewire fault '" + item + "': " + what + " '" +
-                                text + "' is not a number");
-  }
-  return v;
-}
-
-int whole(const std::string& text, const std::string& item, const char* what) {
-  const double v = number(text, item, what);
-  if (v != std::floor(v) || v < 1.0 || v > 1e9) {
-    throw std::invalid_argument("firewire fault '" + item + "': " + what + " '" +
-                                text + "' is not a whole number >= 1");
-  }
-  return static_cast<int>(v);
-}
 
 // FNV-1a, for the made-up GUID
 std::uint64_t text_hash(const std::string& s) {
@@ -140,58 +107,27 @@ void validate_wire_fault(const WireFault& f) {
 
 std::vector<WireFault> parse_wire_faults(const std::string& text) {
   std::vector<WireFault> out;
-  if (text.find_first_not_of(' ') == std::string::npos) return out;
-  for (const std::string& item : split(text, ',')) {
-    const auto at = item.find('@');
-    if (at == std::string::npos) {
-      throw std::invalid_argument("firewire fault '" + item +
-                                  "': expected kind@at_s[:...]");
-    }
-    const std::string kind = item.substr(0, at);
+  for (const FaultItem& it : parse_faults(text, kWireFaults)) {
     WireFault w;
-    bool known = false;
     for (const KindName& n : kKinds) {
-      if (kind == n.name) {
-        w.kind = n.kind;
-        known = true;
-      }
+      if (n.name == std::string(it.kind->name)) w.kind = n.kind;
     }
-    if (!known) {
-      throw std::invalid_argument("firewire fault '" + item + "': unknown kind '" +
-                                  kind +
-                                  "' (loss@t:N, late@t:dur:K, length@t:N, reset@t, "
-                                  "unplug@t:dur, stall@t:dur)");
-    }
-    const std::vector<std::string> f = split(item.substr(at + 1), ':');
-    std::size_t want = 1;
+    w.at_s = it.at_s;
     switch (w.kind) {
       case WireFaultKind::kLoss:
-      case WireFaultKind::kLength:
+      case WireFaultKind::kLength: w.count = static_cast<int>(it.values[0]); break;
+      case WireFaultKind::kLate:
+        w.duration_s = it.values[0];
+        w.count = static_cast<int>(it.values[1]);
+        break;
       case WireFaultKind::kUnplug:
-      case WireFaultKind::kStall: want = 2; break;
-      case WireFaultKind::kLate: want = 3; break;
-      case WireFaultKind::kReset: want = 1; break;
-    }
-    if (f.size() != want) {
-      throw std::invalid_argument(
-          "firewire fault '" + item + "': " + kind + " takes " +
-          (want == 1 ? std::string("only its time") : std::to_string(want) + " fields") +
-          " (loss@t:N, late@t:dur:K, length@t:N, reset@t, unplug@t:dur, "
-          "stall@t:dur)");
-    }
-    w.at_s = number(f[0], item, "time");
-    if (w.kind == WireFaultKind::kLoss || w.kind == WireFaultKind::kLength) {
-      w.count = whole(f[1], item, "packet count");
-    } else if (w.kind == WireFaultKind::kLate) {
-      w.duration_s = number(f[1], item, "duration");
-      w.count = whole(f[2], item, "period count");
-    } else if (want == 2) {
-      w.duration_s = number(f[1], item, "duration");
+      case WireFaultKind::kStall: w.duration_s = it.values[0]; break;
+      case WireFaultKind::kReset: break;
     }
     try {
       validate_wire_fault(w);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument("firewire fault '" + item + "': " + e.what());
+      throw std::invalid_argument("firewire fault '" + it.text + "': " + e.what());
     }
     out.push_back(w);
   }

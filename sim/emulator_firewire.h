@@ -38,8 +38,8 @@
 // "in-process (emulator)"; the generation counts bus resets.
 //
 // Packet-level faults, text form (parse_wire_faults), comma-separated,
-// "kind@at_s[:...]" with at_s in emulator time from start(), as
-// sim::parse_emulator_faults:
+// "kind@at_s[:...]" with at_s in emulator time from start(), in the one
+// fault grammar (sim/fault_vocabulary.h):
 //   loss@t:N          the next N state packets never arrive: N receives
 //                     return kTimeout (the counter still advances)
 //   late@t:dur:K      for dur s, every packet is K periods old (1..63;

@@ -4,6 +4,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "sim/fault_vocabulary.h"
+
 namespace vmh::sim {
 
 const char* sensor_fault_kind_name(SensorFaultKind k) {
@@ -17,11 +19,19 @@ const char* sensor_fault_kind_name(SensorFaultKind k) {
 }
 
 bool parse_sensor_fault_kind(const std::string& text, SensorFaultKind* k) {
-  for (SensorFaultKind c : {SensorFaultKind::kNone, SensorFaultKind::kNan,
-                            SensorFaultKind::kJump, SensorFaultKind::kStuck}) {
-    if (text == sensor_fault_kind_name(c)) {
-      *k = c;
-      return true;
+  if (text == "none") {
+    *k = SensorFaultKind::kNone;
+    return true;
+  }
+  // the sensor kinds of the one fault table (sim/fault_vocabulary.h)
+  for (const FaultKind& f : fault_kinds()) {
+    if (!(f.layers & kSensorFaults) || text != f.name) continue;
+    for (SensorFaultKind c :
+         {SensorFaultKind::kNan, SensorFaultKind::kJump, SensorFaultKind::kStuck}) {
+      if (text == sensor_fault_kind_name(c)) {
+        *k = c;
+        return true;
+      }
     }
   }
   return false;
