@@ -52,7 +52,14 @@ void add_hw_common(CLI::App* cmd, HwCommon* c) {
 }
 
 const runtime::BackendInfo& hw_backend(const HwCommon& c, std::string* argument) {
-  return runtime::BackendRegistry::global().resolve(c.device, argument);
+  const runtime::BackendRegistry& reg = runtime::BackendRegistry::global();
+  if (c.device == "emulator" && reg.find("emulator") == nullptr) {
+    // the default device where the build has no testbed
+    throw UsageError("--device: this build has no emulator (it was built "
+                     "without MuJoCo, VMH_BUILD_SIM=OFF); give one of " +
+                     reg.grammars());
+  }
+  return reg.resolve(c.device, argument);
 }
 
 bool hw_lockstep(const HwCommon& c) {

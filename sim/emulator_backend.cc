@@ -136,10 +136,14 @@ EmulatorOptions emulator_options(const OpenRequest& rq, const std::string& what,
   std::string name;
   try {
     eo.scene = resolve_scene(rq.argument.empty() ? "case1" : rq.argument, &name);
-    // through the wire, --fault names packet faults (parsed by the caller)
-    if (!wire) eo.faults = parse_emulator_faults(rq.option("fault"));
   } catch (const std::exception& e) {
     throw RequestError("--device " + what + ": " + e.what());
+  }
+  try {
+    // through the wire, --fault names packet faults (parsed by the caller)
+    if (!wire) eo.faults = parse_emulator_faults(rq.option("fault"));
+  } catch (const std::invalid_argument& e) {
+    throw RequestError(std::string("--fault: ") + e.what());
   }
   try {
     eo.seeded = parse_seeded_faults(rq.option("emulator-fault"));
