@@ -375,8 +375,62 @@ TEST(HwCli, MalformedStoredCalibrationIsNamed) {
   EXPECT_NE(r.err.find("EMU-0001.json"), std::string::npos) << r.err;
 }
 
+// A sweep too short to reach every gimbal joint's ends (the emulator's hand
+// turns t4, t5, t6 in turn, 3 s each): the fit is refused naming the joint
+// it missed and what to redo, nothing is stored, exit 1.
+TEST(HwCli, CalibrateRefusesASweepThatMissedAJoint) {
+  const std::string cfg = ::testing::TempDir() + "vmh_hw_cfg_short";
+  fs::remove_all(cfg);
+  const auto r = run("hw calibrate --device emulator --sweep-s 3 --quiet",
+                     "XDG_CONFIG_HOME=" + cfg + " ");
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.err.find("the sweep of t5 covered codes"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("turn t5 fully"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nothing stored"), std::string::npos) << r.err;
+  // a dock phase too short for the hand to settle in the inkwell: the
+  // encoders still moved over its last second
+  const auto d = run("hw calibrate --device emulator --dock-s 1.5 --quiet",
+                     "XDG_CONFIG_HOME=" + cfg + " ");
+  EXPECT_EQ(d.exit_code, 1) << d.out;
+  EXPECT_NE(d.err.find("moved by"), std::string::npos) << d.err;
+  EXPECT_NE(d.err.find("while docked"), std::string::npos) << d.err;
+  EXPECT_FALSE(fs::exists(cfg + "/vmhaptics/calibration/EMU-0001.json"));
+}
+
+// Two recordings into one --out at the same time: each writes its own set
+// and puts it in place whole, so both succeed and the folder holds one of
+// them, trace and meta agreeing, every row whole.
+TEST(HwCli, TwoWritersOfOneFolderLeaveOneWholeSet) {
+  const fs::path out = fresh_dir("two_writers");
+  const std::string cmd = std::string(VMH_CLI_PATH) +
+                          " hw record --device emulator --duration 4 --quiet --out " +
+                          out.string() + " > /dev/null";
+  const std::string both = kEnv + cmd + " & p=$!; " + kEnv + cmd +
+                           " & q=$!; wait $p; a=$?; wait $q; b=$?; exit $((a + b))";
+  EXPECT_EQ(std::system(("bash -c '" + both + "'").c_str()), 0);
+  const Csv c = read_csv(out / "trace.csv");
+  for (const auto& row : c.rows) ASSERT_EQ(row.size(), c.header.size());
+  std::ifstream in(out / "meta.json");
+  const json m = json::parse(in);
+  EXPECT_EQ(static_cast<long>(c.rows.size()),
+            m.at("session").at("ticks").get<long>());
+  // t_s strictly increasing: no rows of the other writer in between
+  const int t = c.column("t_s");
+  for (std::size_t k = 1; k < c.rows.size(); ++k) {
+    ASSERT_GT(std::stod(c.rows[k][t]), std::stod(c.rows[k - 1][t])) << k;
+  }
+  // nothing left behind but the set
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(out.parent_path())) {
+    if (e.path().filename().string().find("vmh_hw_two_writers") != std::string::npos) {
+      ++entries;
+    }
+  }
+  EXPECT_EQ(entries, 1);
+}
+
 // `hw run --device emulator caseN` reproduces `run caseN`'s claims, on the
-// emulator in real time (20 s each).
+// emulator in lockstep (20 s each, about a second of wall time).
 class HwRunCase : public ::testing::TestWithParam<int> {};
 
 TEST_P(HwRunCase, ReproducesTheThesisClaims) {
@@ -401,5 +455,35 @@ TEST_P(HwRunCase, ReproducesTheThesisClaims) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, HwRunCase, ::testing::Range(1, 7));
+
+// The same on the wall clock, as a device runs: on an idle host the claims
+// hold; on a busy one the session may be disturbed (overruns, read
+// timeouts, an emulator stall), and then hw run says so and judges no
+// claim, rather than fail or pass one on the host's account. Either way
+// the set is whole and the device left at zero torque.
+TEST(HwRunRealtime, ClaimsHoldOrTheDisturbanceIsNamed) {
+  const fs::path out = fresh_dir("run_realtime");
+  const auto r = run("hw run --device emulator --clock realtime case1 "
+                     "--duration 6 --quiet --out " + out.string(), kEnv);
+  const json j = parse(r.out);
+  EXPECT_EQ(j.at("clock"), "realtime");
+  if (j.value("claims_judged", false)) {
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    for (const auto& c : j.at("claims")) {
+      EXPECT_TRUE(c.at("pass").get<bool>()) << c.dump();
+    }
+  } else {
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_TRUE(r.err.find("did not keep real time") != std::string::npos ||
+                r.err.find("emulator_stalled") != std::string::npos)
+        << r.err;
+    EXPECT_TRUE(j.at("claims").empty());
+  }
+  const Csv c = read_csv(out / "trace.csv");
+  ASSERT_GT(c.rows.size(), 100u);
+  for (const auto& row : c.rows) ASSERT_EQ(row.size(), c.header.size());
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+  EXPECT_TRUE(fs::exists(out / "meta.json"));
+}
 
 }  // namespace
