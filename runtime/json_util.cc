@@ -23,7 +23,7 @@ bool flat(const Json& j) {
 
 // compact text with a space after each comma, for one-line arrays
 std::string one_line(const Json& j) {
-  if (!j.is_array()) return j.dump();
+  if (!j.is_array()) return j.dump();  // a scalar, or an empty object: {}
   std::string s = "[";
   bool first = true;
   for (const Json& item : j) {
@@ -35,7 +35,7 @@ std::string one_line(const Json& j) {
 }
 
 void write(const Json& j, int indent, std::string* out) {
-  if (flat(j)) {
+  if (flat(j) || j.empty()) {
     *out += one_line(j);
     return;
   }
