@@ -29,6 +29,12 @@
 //
 // BM_RunAll: sim::run_cases on the six thesis cases, 20 s each, on two
 // threads, writing nothing; one iteration is one `run --all`.
+//
+// BM_HwRunLockstep (case 1..6): `hw run --device emulator caseN` in
+// lockstep, as studies::HwRunCase runs it (the emulator opened, the
+// session through the runtime's loop and safety layer, the claims judged),
+// writing nothing; one iteration is the case's 20 s. realtime_x is
+// simulated seconds per wall second: above 1 is faster than real time.
 #include <benchmark/benchmark.h>
 
 #include <mujoco/mujoco.h>
@@ -37,7 +43,11 @@
 #include <string>
 #include <vector>
 
+#include "runtime/backend_registry.h"
+#include "runtime/session.h"
 #include "sim/closed_loop.h"
+#include "sim/emulator_backend.h"
+#include "studies/hw_run.h"
 #include "studies/run_case.h"
 
 namespace vmh::sim {
@@ -213,6 +223,32 @@ void BM_RunAll(benchmark::State& state) {
   state.counters["claims_failed"] = claims_failed;
 }
 
+void BM_HwRunLockstep(benchmark::State& state) {
+  runtime::BackendRegistry registry;
+  register_backends(&registry);
+  const std::string scene = case_scene(static_cast<int>(state.range(0)));
+  double simulated_s = 0.0;
+  int claims_failed = 0;
+  for (auto _ : state) {
+    studies::HwRunCase run(scene, {}, "", 1.0, true);
+    runtime::OpenRequest rq;
+    rq.defaults["hand"] = "case";
+    rq.load_calibration = false;
+    rq.lockstep = true;
+    runtime::OpenedDevice dev = registry.open("emulator:" + scene, rq);
+    runtime::SessionOptions so;
+    so.servo.lockstep = true;
+    so.progress = false;
+    runtime::SessionResult r;
+    const Json summary = run.run(&dev, so, &r);
+    simulated_s += r.duration_s + r.timing.nominal_period_s;
+    if (!summary.value("all_claims_pass", false)) ++claims_failed;
+  }
+  state.counters["realtime_x"] =
+      benchmark::Counter(simulated_s, benchmark::Counter::kIsRate);
+  state.counters["claims_failed"] = claims_failed;
+}
+
 // every case in the scene's setting, and cases 1 and 6 in the old one
 void cases_and_settings(benchmark::internal::Benchmark* b) {
   for (int c = 1; c <= 6; ++c) b->Args({c, 0});
@@ -224,6 +260,8 @@ BENCHMARK(BM_HeldHandStep)->Args({1, 0});
 BENCHMARK(BM_ReplayStep)->Args({1, 0});
 BENCHMARK(BM_ClosedLoopTick)->Apply(cases_and_settings);
 BENCHMARK(BM_RunAll)->Iterations(1)->UseRealTime()->Unit(benchmark::kSecond);
+BENCHMARK(BM_HwRunLockstep)->DenseRange(1, 6)->Iterations(1)->UseRealTime()
+    ->Unit(benchmark::kSecond);
 
 }  // namespace
 }  // namespace vmh::sim
