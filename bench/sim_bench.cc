@@ -230,7 +230,7 @@ void BM_HwRunLockstep(benchmark::State& state) {
   double simulated_s = 0.0;
   int claims_failed = 0;
   for (auto _ : state) {
-    studies::HwRunCase run(scene, {}, "", 1.0, true);
+    studies::HwRunCase run(scene, {}, "", 1.0);
     runtime::OpenRequest rq;
     rq.defaults["hand"] = "case";
     rq.load_calibration = false;

@@ -217,9 +217,7 @@ void register_hw(CLI::App* app) {
       "write DIR/trace.csv and DIR/meta.json, together (a set replaced whole)");
   m->callback([mo]() { motor_test(*mo); });
 
-#ifdef VMH_HAVE_SIM
   register_hw_run(hw);
-#endif
   register_hw_calibrate(hw);
   register_hw_packet(hw);
   register_hw_capture(hw);

@@ -3,8 +3,9 @@
 //                  [--model FILE] [--emulator-fault LIST] [--clock C]
 //
 // The scene's controller on a device, through the servo chain and the
-// safety layer (studies/hw_run.h does it; this file parses, calls and
-// prints). DIR/trace.csv has run's columns; DIR/summary.json the session
+// safety layer (studies/hw_run.h for a simulated device and its claims;
+// on a real device the scene's parameters, read without MuJoCo, and the
+// runtime's session; this file parses, calls and prints). DIR/trace.csv has run's columns; DIR/summary.json the session
 // and, on the emulator, the same metrics and thesis claims as `run`
 // (measured on the emulator's ground truth); DIR/meta.json the device. The
 // three are written together. --model FILE (emulator only) replaces the
@@ -21,8 +22,11 @@
 #include "cli/hw.h"
 #include "cli/hw_common.h"
 #include "runtime/meta.h"
+#include "sim/scene_fields.h"
+#ifdef VMH_HAVE_SIM
 #include "sim/case_catalogue.h"
 #include "studies/hw_run.h"
+#endif
 
 namespace vmh::cli {
 namespace {
@@ -38,6 +42,52 @@ struct HwRunArgs {
   double gain_scale = 1.0;
 };
 
+// the target's scene: a case name (with the testbed's catalogue) or a file
+std::string scene_of(const std::string& target, std::string* name) {
+#ifdef VMH_HAVE_SIM
+  try {
+    return sim::resolve_scene(target, name);
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("hw run: ") + e.what());
+  }
+#else
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(target, ec)) {
+    throw UsageError("hw run: '" + target +
+                     "' is not a scene file (this build has no case "
+                     "catalogue: give the scene's path, e.g. "
+                     "models/cases/case1.xml)");
+  }
+  *name = std::filesystem::path(target).stem().string();
+  return target;
+#endif
+}
+
+// A real device: the scene's parameters read without MuJoCo, the case's
+// controller through the safety layer; no truth, so no claims.
+Json run_on_device(runtime::OpenedDevice* dev, const std::string& scene,
+                   const std::vector<std::string>& sets, double gain_scale,
+                   runtime::SessionOptions so, runtime::SessionResult* r) {
+  sim::CaseParams params;
+  try {
+    params = sim::load_scene_params(scene, sets);
+  } catch (const sim::ParamError& e) {
+    throw UsageError(std::string("hw run: ") + e.what());
+  }
+  ControllerParams controller = sim::case_controller_params(params);
+  runtime::scale_gains(&controller, gain_scale);
+  runtime::configure_controller_session(controller, &so);
+  so.duration_s = params.sim.duration_s;
+  *r = runtime::run_session(dev, so);
+  return Json{{"thesis_case", params.thesis_case},
+              {"gain_scale", gain_scale},
+              {"clock", r->clock},
+              {"claims", Json::array()},
+              {"claims_measured_on",
+               "nothing: a real device has no ground truth for the thesis's "
+               "claims"}};
+}
+
 void hw_run(const HwRunArgs& a) {
   if (a.duration_given) {
     check_seconds("hw run: --duration", a.duration_s, 0.0, 3600.0);
@@ -46,12 +96,7 @@ void hw_run(const HwRunArgs& a) {
     throw UsageError("hw run: --gain-scale must be a number >= 0");
   }
   std::string name;
-  std::string scene;
-  try {
-    scene = sim::resolve_scene(a.target, &name);
-  } catch (const sim::SimError& e) {
-    throw UsageError(std::string("hw run: ") + e.what());
-  }
+  const std::string scene = scene_of(a.target, &name);
   std::vector<std::string> sets = a.sets;
   if (a.duration_given) {
     char text[40];
@@ -73,12 +118,26 @@ void hw_run(const HwRunArgs& a) {
   }
   const bool out_given = a.out_option != nullptr && a.out_option->count() > 0;
   auto set = hw_output_set("run", a.out, out_given);
+#ifdef VMH_HAVE_SIM
+  // a simulated device: the case with its script and claims, loaded first
+  // so that a bad scene is refused before the device opens
   std::unique_ptr<studies::HwRunCase> run_case;
-  try {
-    run_case = std::make_unique<studies::HwRunCase>(
-        scene, sets, model_file, a.gain_scale, backend.simulated);
-  } catch (const sim::SimError& e) {
-    throw UsageError(std::string("hw run: ") + e.what());
+  if (backend.simulated) {
+    try {
+      run_case = std::make_unique<studies::HwRunCase>(scene, sets, model_file,
+                                                      a.gain_scale);
+    } catch (const sim::SimError& e) {
+      throw UsageError(std::string("hw run: ") + e.what());
+    }
+  }
+#endif
+  if (!backend.simulated) {
+    // refuse a bad scene before the device opens
+    try {
+      (void)sim::load_scene_params(scene, sets);
+    } catch (const sim::ParamError& e) {
+      throw UsageError(std::string("hw run: ") + e.what());
+    }
   }
   // a simulated device plays the scene itself, held by its hand script
   runtime::OpenedDevice dev = open_hw_device(
@@ -87,7 +146,13 @@ void hw_run(const HwRunArgs& a) {
   trace_into(set.get(), a.out, &so);
   runtime::SessionResult r;
   Json summary{{"case", name}, {"scene", scene}};
-  const Json measured = run_case->run(&dev, so, &r);
+  Json measured;
+#ifdef VMH_HAVE_SIM
+  if (run_case) measured = run_case->run(&dev, so, &r);
+#endif
+  if (measured.is_null()) {
+    measured = run_on_device(&dev, scene, sets, a.gain_scale, so, &r);
+  }
   for (auto it = measured.begin(); it != measured.end(); ++it) {
     summary[it.key()] = it.value();
   }

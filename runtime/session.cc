@@ -109,6 +109,25 @@ std::string signal_name(int s) {
 
 }  // namespace
 
+void configure_controller_session(const ControllerParams& params,
+                                  SessionOptions* so) {
+  so->chain.mode = ChainMode::kRun;
+  so->chain.controller = params;
+  so->chain.safety = true;
+  const bool deadman = so->chain.safety_params.require_deadman;
+  so->chain.safety_params = safety_params_for(params);
+  so->chain.safety_params.require_deadman = deadman;
+  so->chain.guard.max_period_s = 4.0 * params.servo_period_s;
+  so->servo.period_s = params.servo_period_s;
+}
+
+void scale_gains(ControllerParams* params, double scale) {
+  params->gains.k_pos_N_per_mm *= scale;
+  params->gains.k_ornt_Nmm_per_rad *= scale;
+  params->gains.k_vel_Ns_per_mm *= scale;
+  params->gains.k_vel_ornt_Nmms_per_rad *= scale;
+}
+
 SessionResult run_session(OpenedDevice* dev, const SessionOptions& o) {
   DeviceBackend& backend = *dev->backend;
   SessionLoop loop(backend.device(), o.chain, o.servo.period_s, o.duration_s,

@@ -76,6 +76,15 @@ struct SessionResult {
   DeviceState last_reading;
 };
 
+// A controller's session as `hw run` and the viewer run it: the chain in
+// run mode behind the safety layer with the controller's limits
+// (safety_params_for; the dead-man setting kept), the reading guard's
+// longest period 4 servo periods, the servo period the controller's.
+void configure_controller_session(const ControllerParams& params,
+                                  SessionOptions* so);
+// every gain of a controller times `scale` (bring-up: start low)
+void scale_gains(ControllerParams* params, double scale);
+
 // Runs one session on an opened device. Throws DeviceOpenError if the loop
 // cannot start (nothing written then), std::runtime_error naming the file
 // when the trace cannot be written (the device is stopped at zero torque

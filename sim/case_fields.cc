@@ -8,7 +8,6 @@
 
 #include "controller/virtual_mechanism.h"
 #include "sim/case_params_detail.h"
-#include "sim/sim_device.h"  // kMaxDelayTicks
 
 namespace vmh::sim {
 namespace {

@@ -305,6 +305,52 @@ CaseParams load_case_params(const std::string& source,
   return c;
 }
 
+CaseParams case_params_from_fields(const std::vector<CustomField>& fields,
+                                   const std::string& source,
+                                   const std::vector<std::string>& overrides) {
+  for (const CustomField& field : fields) {
+    const ParamSpec* f = find_param(field.name);
+    if (f == nullptr) {
+      throw ParamError(source + ": unknown <custom> field '" + field.name +
+                       "' (known: " + param_names() + ")");
+    }
+    if (f->is_text != field.is_text) {
+      throw ParamError(source + ": <custom> field '" + field.name +
+                       "' must be a <" + (f->is_text ? "text" : "numeric") +
+                       ">, not a <" + (field.is_text ? "text" : "numeric") +
+                       ">");
+    }
+  }
+  // in the table's order, as given (a field named twice: MuJoCo keeps one
+  // of each name, so the last is taken)
+  std::vector<ParamInput> inputs;
+  for (const ParamSpec& spec : case_fields()) {
+    const CustomField* given = nullptr;
+    for (const CustomField& field : fields) {
+      if (field.name == spec.name) given = &field;
+    }
+    if (given != nullptr) {
+      inputs.push_back({spec.name, given->value, ValueSource::kScene, source});
+    }
+  }
+  for (ParamInput& set : set_inputs(overrides)) inputs.push_back(std::move(set));
+  return load_case_params(source, inputs);
+}
+
+ControllerParams case_controller_params(const CaseParams& c) {
+  ControllerParams p = controller_params(c);
+  if (!c.sim.gimbal_limits) {
+    // no limits on q4..q6: ranges that cover every angle for the
+    // controller's check, the start pose's IK and the pots' span
+    constexpr double kPi = 3.14159265358979323846;
+    for (std::size_t i = 3; i < 6; ++i) {
+      p.omni.joint_lower_rad[i] = -kPi;
+      p.omni.joint_upper_rad[i] = kPi;
+    }
+  }
+  return p;
+}
+
 ControllerParams controller_params(const ControllerSettings& s) {
   ControllerParams p;
   p.vm.kind = s.vm_kind;

@@ -44,6 +44,8 @@ struct ParamError : std::runtime_error {
 // table's ranges (duration_s <= 3600 s, servo_period_s >= 1e-5 s) keep it
 // below 3.6e8.
 inline constexpr std::int64_t kMaxSubstepsPerTick = 1000000;
+// the longest delay line of the simulated device, servo ticks
+inline constexpr int kMaxDelayTicks = 64;
 inline constexpr std::int64_t kMaxTicksPerRun = 1000000000;
 
 // Where a value came from.
@@ -240,12 +242,35 @@ std::vector<ParamInput> ctl_inputs(
 CaseParams load_case_params(const std::string& source,
                             const std::vector<ParamInput>& inputs);
 
+// One <custom> field of a scene: its name, whether it is a <text>, and its
+// value as text (a <numeric>'s numbers space-separated, full precision)
+struct CustomField {
+  std::string name;
+  bool is_text = false;
+  std::string value;
+};
+
+// A scene's case parameters from its <custom> fields (read by MuJoCo,
+// sim/case_config.h, or without it, sim/scene_fields.h), with `overrides`
+// ("name=value", --set) on top. Every field must be one the table knows,
+// under its kind's tag: a number written as <text> (or a word as
+// <numeric>) would otherwise be skipped and its default used without a
+// word. Throws ParamError naming `source` (the scene file) and the field.
+CaseParams case_params_from_fields(const std::vector<CustomField>& fields,
+                                   const std::string& source,
+                                   const std::vector<std::string>& overrides);
+
 // The controller's parameters: the one route from settings to
 // ControllerParams for scenes and `ctl`.
 ControllerParams controller_params(const ControllerSettings& s);
 inline ControllerParams controller_params(const CaseParams& c) {
   return controller_params(c.controller);
 }
+// A case's controller as the device it runs on sees it: controller_params,
+// with the gimbal's ranges opened to +-pi when the case has no gimbal
+// limits (gimbal_limits = 0: the wrist free to turn through its
+// singularity). What the simulated loop and `hw run` both run.
+ControllerParams case_controller_params(const CaseParams& c);
 
 // The parameter behind a ControllerParams::validate message ("controller
 // parameter <field>: ..."); nullptr if none.

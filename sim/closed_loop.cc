@@ -166,16 +166,14 @@ void ClosedLoop::setup_jitter(double h) {
 
 void ClosedLoop::build_controller() {
   mjModel* m = model_.get();
-  params_ = sim::controller_params(config_);
+  // the case's controller, the gimbal's ranges opened without its limits
+  params_ = case_controller_params(config_);
   if (!config_.sim.gimbal_limits) {
-    // the wrist free to turn through its singularity: no limits on q4..q6 in
-    // the model, and ranges that cover every angle for the controller's
-    // check, the start pose's IK and the potentiometers' span
+    // the wrist free to turn through its singularity: no limits on q4..q6
+    // in the model either
     for (int i = 3; i < 6; ++i) {
       const std::string name = "q" + std::to_string(i + 1);
       m->jnt_limited[require_id(m, mjOBJ_JOINT, name.c_str(), path_)] = 0;
-      params_.omni.joint_lower_rad[static_cast<std::size_t>(i)] = -kPi;
-      params_.omni.joint_upper_rad[static_cast<std::size_t>(i)] = kPi;
     }
   }
   // the motors' range follows the case's torque limits (torque_limits):

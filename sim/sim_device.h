@@ -16,13 +16,13 @@
 
 #include "device/haptic_device.h"
 #include "controller/omni_params.h"
+#include "sim/case_params.h"  // kMaxDelayTicks
 #include "sim/sensor_model.h"
 
 namespace vmh::sim {
 
 // the longest delay line: 64 servo ticks is 64 ms at 1 kHz, far beyond any
 // USB or FireWire device (case_config checks delay_ticks against it)
-inline constexpr int kMaxDelayTicks = 64;
 
 class SimDevice final : public HapticDevice {
  public:

@@ -10,31 +10,19 @@ namespace vmh::studies {
 
 HwRunCase::HwRunCase(const std::string& scene,
                      const std::vector<std::string>& sets,
-                     const std::string& model_file, double gain_scale,
-                     bool simulated)
+                     const std::string& model_file, double gain_scale)
     : loop_(std::make_unique<sim::ClosedLoop>(scene, sets,
                                               sim::omni_model_hook(model_file))),
       params_(loop_->controller_params()),
       thesis_case_(loop_->config().thesis_case),
       duration_s_(loop_->config().sim.duration_s),
       gain_scale_(gain_scale) {
-  if (!simulated) loop_.reset();
-  params_.gains.k_pos_N_per_mm *= gain_scale;
-  params_.gains.k_ornt_Nmm_per_rad *= gain_scale;
-  params_.gains.k_vel_Ns_per_mm *= gain_scale;
-  params_.gains.k_vel_ornt_Nmms_per_rad *= gain_scale;
+  runtime::scale_gains(&params_, gain_scale);
 }
 
 void HwRunCase::configure(runtime::SessionOptions* so) const {
-  so->chain.mode = ChainMode::kRun;
-  so->chain.controller = params_;
+  runtime::configure_controller_session(params_, so);
   so->chain.reference = reference_params(thesis_case(), params_);
-  so->chain.safety = true;
-  const bool deadman = so->chain.safety_params.require_deadman;
-  so->chain.safety_params = safety_params_for(params_);
-  so->chain.safety_params.require_deadman = deadman;
-  so->chain.guard.max_period_s = 4.0 * params_.servo_period_s;
-  so->servo.period_s = params_.servo_period_s;
   so->duration_s = duration_s();
 }
 
@@ -63,7 +51,7 @@ Json HwRunCase::run(runtime::OpenedDevice* dev, runtime::SessionOptions so,
       std::llround(so.duration_s / params_.servo_period_s));
   const std::int64_t every =
       std::max<std::int64_t>(1, (ticks + kMaxKeptTicks - 1) / kMaxKeptTicks);
-  const bool truth = dev->truth != nullptr && loop_ != nullptr;
+  const bool truth = dev->truth != nullptr;
   std::optional<MetricsAccumulator> metrics;
   if (truth) metrics.emplace(*loop_);
   std::vector<TickRecord> rows;

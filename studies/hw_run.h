@@ -27,19 +27,18 @@
 
 namespace vmh::studies {
 
-// The case as `hw run` plays it: its scene's parameters, script and claims'
-// settings (the scene loaded once), and the controller scaled for bring-up.
+// The case as `hw run` plays it on a simulated device: its scene's
+// parameters, script and claims' settings (the scene loaded once), and the
+// controller scaled for bring-up. (On a real device `hw run` needs only
+// the parameters: sim/scene_fields.h and runtime's
+// configure_controller_session.)
 class HwRunCase {
  public:
   // Throws SimError naming the scene and field. `model_file` (may be
   // empty): a calibrated Omni MJCF (sim::omni_model_hook). `sets` are the
-  // scene's --set overrides. `simulated`: the device is a simulated plant
-  // whose truth the claims are measured on; otherwise only the parameters
-  // are kept and the scene's model is let go (its hand holds MuJoCo's
-  // control callback, which a simulated device in the same process, such
-  // as the test libHD.so's, needs for its own)
+  // scene's --set overrides.
   HwRunCase(const std::string& scene, const std::vector<std::string>& sets,
-            const std::string& model_file, double gain_scale, bool simulated);
+            const std::string& model_file, double gain_scale);
 
   // the session options' chain, period and duration for this case
   void configure(runtime::SessionOptions* so) const;
@@ -53,7 +52,7 @@ class HwRunCase {
   const ControllerParams& params() const { return params_; }
 
  private:
-  // the case: parameters, script (kept for a simulated device's claims)
+  // the case: parameters, script, the claims' geometry
   std::unique_ptr<sim::ClosedLoop> loop_;
   ControllerParams params_;
   int thesis_case_ = 0;

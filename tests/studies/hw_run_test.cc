@@ -83,7 +83,7 @@ TEST_P(HwRunLockstep, MatchesTheSimulatedLoopBehindTheSafetyLayer) {
   const std::string scene = thesis_case_scene(n);
   const std::vector<std::string> sets = {"duration_s=8"};
 
-  HwRunCase hw(scene, sets, "", 1.0, true);
+  HwRunCase hw(scene, sets, "", 1.0);
   runtime::OpenedDevice dev = open_emulator(scene, sets);
   runtime::SessionResult session;
   const Json summary = hw.run(&dev, lockstep_session(), &session);
@@ -126,7 +126,7 @@ TEST(HwRunLockstepDeterminism, TwoSessionsGiveTheSameRecords) {
   for (auto& run : runs) {
     runtime::OpenedDevice dev = open_emulator(scene, {"duration_s=2"});
     runtime::SessionOptions so = lockstep_session();
-    HwRunCase hw(scene, {"duration_s=2"}, "", 1.0, true);
+    HwRunCase hw(scene, {"duration_s=2"}, "", 1.0);
     hw.configure(&so);
     so.on_record = [&run](const TickRecord& r) {
       run.push_back({r.t_s, r.q_dh[0], r.q_dh[4], r.tau_sent_Nm[1],

@@ -1,0 +1,298 @@
+#include "sim/scene_fields.h"
+
+#include <sys/stat.h>
+
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace vmh::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{64} << 20;
+constexpr int kMaxIncludeDepth = 16;
+
+struct Attribute {
+  std::string name;
+  std::string value;
+};
+
+class SceneReader {
+ public:
+  explicit SceneReader(const std::string& main_path)
+      : main_dir_(fs::path(main_path).parent_path()) {}
+
+  void read(const std::string& path, bool in_custom, int depth) {
+    if (depth > kMaxIncludeDepth) {
+      throw ParamError(path + ": includes nested more than " +
+                       std::to_string(kMaxIncludeDepth) + " deep");
+    }
+    const std::string key = identity(path);
+    for (const std::string& open : open_files_) {
+      if (open == key) throw ParamError(path + ": includes itself (a cycle)");
+    }
+    open_files_.push_back(key);
+    parse(load(path), path, in_custom, depth);
+    open_files_.pop_back();
+  }
+
+  std::vector<CustomField> fields;
+
+ private:
+  // the file's identity for cycle detection: device and inode
+  static std::string identity(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) return path;
+    return std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  }
+
+  static std::string load(const std::string& path) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (ec || !fs::exists(st)) throw ParamError(path + ": no such file");
+    // a FIFO or a device would block the read or never end
+    if (!fs::is_regular_file(st)) {
+      throw ParamError(path + ": not a regular file (a scene is an MJCF file)");
+    }
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (ec || size > kMaxFileBytes) {
+      throw ParamError(path + ": larger than 64 MB");
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw ParamError(path + ": cannot be read");
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+  [[noreturn]] static void fail(const std::string& path, const std::string& text,
+                                std::size_t pos, const std::string& why) {
+    int line = 1;
+    for (std::size_t i = 0; i < pos && i < text.size(); ++i) {
+      if (text[i] == '\n') ++line;
+    }
+    throw ParamError(path + ": line " + std::to_string(line) + ": " + why);
+  }
+
+  static bool name_char(char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == ':' ||
+           c == '-' || c == '.';
+  }
+
+  // the five predefined entities and numeric references
+  static std::string decode(const std::string& v, const std::string& path,
+                            const std::string& text, std::size_t pos) {
+    std::string out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (v[i] != '&') {
+        out += v[i];
+        continue;
+      }
+      const std::size_t end = v.find(';', i);
+      if (end == std::string::npos) fail(path, text, pos, "'&' without ';' in an attribute");
+      const std::string e = v.substr(i + 1, end - i - 1);
+      if (e == "amp") out += '&';
+      else if (e == "lt") out += '<';
+      else if (e == "gt") out += '>';
+      else if (e == "quot") out += '"';
+      else if (e == "apos") out += '\'';
+      else if (e.size() > 1 && e[0] == '#') {
+        const bool hex = e[1] == 'x';
+        char* stop = nullptr;
+        const long c = std::strtol(e.c_str() + (hex ? 2 : 1), &stop, hex ? 16 : 10);
+        if (*stop != '\0' || c <= 0 || c > 127) {
+          fail(path, text, pos, "character reference &" + e + "; is not ASCII");
+        }
+        out += static_cast<char>(c);
+      } else {
+        fail(path, text, pos, "unknown entity &" + e + ";");
+      }
+      i = end;
+    }
+    return out;
+  }
+
+  static const std::string* find(const std::vector<Attribute>& attrs,
+                                 const char* name) {
+    for (const Attribute& a : attrs) {
+      if (a.name == name) return &a.value;
+    }
+    return nullptr;
+  }
+
+  void element(const std::string& name, const std::vector<Attribute>& attrs,
+               bool in_custom, int depth, const std::string& path,
+               const std::string& text, std::size_t pos) {
+    if (name == "include") {
+      const std::string* file = find(attrs, "file");
+      if (file == nullptr || file->empty()) {
+        fail(path, text, pos, "<include> without a file");
+      }
+      const fs::path p = fs::path(*file).is_absolute() ? fs::path(*file)
+                                                      : main_dir_ / *file;
+      read(p.string(), in_custom, depth + 1);
+      return;
+    }
+    if (!in_custom || (name != "numeric" && name != "text")) return;
+    const std::string* field = find(attrs, "name");
+    if (field == nullptr || field->empty()) {
+      fail(path, text, pos, "<" + name + "> without a name");
+    }
+    CustomField f;
+    f.name = *field;
+    f.is_text = name == "text";
+    const std::string* data = find(attrs, "data");
+    if (f.is_text) {
+      if (data == nullptr) fail(path, text, pos, "<text name=\"" + f.name + "\"> without data");
+      f.value = *data;
+      fields.push_back(std::move(f));
+      return;
+    }
+    std::vector<std::string> numbers;
+    if (data != nullptr) {
+      std::istringstream in(*data);
+      std::string n;
+      while (in >> n) numbers.push_back(n);
+    }
+    const std::string* size_text = find(attrs, "size");
+    std::size_t size = numbers.size();
+    if (size_text != nullptr) {
+      char* stop = nullptr;
+      const long s = std::strtol(size_text->c_str(), &stop, 10);
+      if (size_text->empty() || *stop != '\0' || s < 0 || s > 1000000) {
+        fail(path, text, pos, "<numeric name=\"" + f.name + "\"> size '" +
+                                  *size_text + "' is not a count");
+      }
+      if (numbers.size() > static_cast<std::size_t>(s)) {
+        fail(path, text, pos, "<numeric name=\"" + f.name +
+                                  "\"> has more data than its size");
+      }
+      size = static_cast<std::size_t>(s);
+    } else if (data == nullptr) {
+      fail(path, text, pos, "<numeric name=\"" + f.name + "\"> has neither data nor size");
+    }
+    if (size == 0) return;  // no values: as if not given
+    while (numbers.size() < size) numbers.push_back("0");
+    for (const std::string& n : numbers) f.value += n + " ";
+    fields.push_back(std::move(f));
+  }
+
+  void parse(const std::string& text, const std::string& path,
+             bool base_in_custom, int depth) {
+    std::vector<std::string> stack;
+    int custom_open = 0;
+    std::size_t i = 0;
+    const auto skip_space = [&] {
+      while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    };
+    while (true) {
+      const std::size_t lt = text.find('<', i);
+      if (lt == std::string::npos) break;
+      i = lt;
+      if (text.compare(i, 4, "<!--") == 0) {
+        const std::size_t end = text.find("-->", i + 4);
+        if (end == std::string::npos) fail(path, text, i, "a comment is not closed");
+        i = end + 3;
+        continue;
+      }
+      if (text.compare(i, 2, "<?") == 0) {
+        const std::size_t end = text.find("?>", i + 2);
+        if (end == std::string::npos) fail(path, text, i, "'<?' is not closed");
+        i = end + 2;
+        continue;
+      }
+      if (text.compare(i, 2, "<!") == 0) {
+        fail(path, text, i, "DTDs and CDATA are not MJCF");
+      }
+      if (text.compare(i, 2, "</") == 0) {
+        i += 2;
+        const std::size_t start = i;
+        while (i < text.size() && name_char(text[i])) ++i;
+        const std::string name = text.substr(start, i - start);
+        skip_space();
+        if (i >= text.size() || text[i] != '>') fail(path, text, start, "bad closing tag");
+        ++i;
+        if (stack.empty() || stack.back() != name) {
+          fail(path, text, start, "</" + name + "> closes " +
+                                      (stack.empty() ? "nothing" : "<" + stack.back() + ">"));
+        }
+        if (name == "custom") --custom_open;
+        stack.pop_back();
+        continue;
+      }
+      const std::size_t tag = i;
+      ++i;
+      const std::size_t start = i;
+      while (i < text.size() && name_char(text[i])) ++i;
+      const std::string name = text.substr(start, i - start);
+      if (name.empty()) fail(path, text, tag, "'<' without an element name");
+      std::vector<Attribute> attrs;
+      bool self_closing = false;
+      while (true) {
+        skip_space();
+        if (i >= text.size()) fail(path, text, tag, "<" + name + "> is not closed");
+        if (text[i] == '>') {
+          ++i;
+          break;
+        }
+        if (text.compare(i, 2, "/>") == 0) {
+          i += 2;
+          self_closing = true;
+          break;
+        }
+        const std::size_t a = i;
+        while (i < text.size() && name_char(text[i])) ++i;
+        if (i == a) fail(path, text, i, "unexpected '" + std::string(1, text[i]) + "' in <" + name + ">");
+        Attribute attr;
+        attr.name = text.substr(a, i - a);
+        skip_space();
+        if (i >= text.size() || text[i] != '=') {
+          fail(path, text, a, "attribute '" + attr.name + "' without a value");
+        }
+        ++i;
+        skip_space();
+        if (i >= text.size() || (text[i] != '"' && text[i] != '\'')) {
+          fail(path, text, a, "attribute '" + attr.name + "' is not quoted");
+        }
+        const char quote = text[i++];
+        const std::size_t end = text.find(quote, i);
+        if (end == std::string::npos) fail(path, text, a, "attribute '" + attr.name + "' is not closed");
+        attr.value = decode(text.substr(i, end - i), path, text, a);
+        i = end + 1;
+        for (const Attribute& other : attrs) {
+          if (other.name == attr.name) fail(path, text, a, "attribute '" + attr.name + "' given twice");
+        }
+        attrs.push_back(std::move(attr));
+      }
+      element(name, attrs, base_in_custom || custom_open > 0, depth, path, text, tag);
+      if (!self_closing) {
+        stack.push_back(name);
+        if (name == "custom") ++custom_open;
+      }
+    }
+    if (!stack.empty()) fail(path, text, text.size(), "<" + stack.back() + "> is not closed");
+  }
+
+  fs::path main_dir_;
+  std::vector<std::string> open_files_;
+};
+
+}  // namespace
+
+std::vector<CustomField> read_scene_fields(const std::string& scene_path) {
+  SceneReader reader(scene_path);
+  reader.read(scene_path, false, 0);
+  return std::move(reader.fields);
+}
+
+CaseParams load_scene_params(const std::string& scene_path,
+                             const std::vector<std::string>& overrides) {
+  return case_params_from_fields(read_scene_fields(scene_path), scene_path,
+                                 overrides);
+}
+
+}  // namespace vmh::sim
