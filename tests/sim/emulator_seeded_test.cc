@@ -1,36 +1,44 @@
 // sim/emulator_seeded: the seeded faults' text form, and each fault's
 // effect on a running emulator, against its ground truth. The emulator
-// runs in real time; the tests wait for what must happen and never assert
-// how long it took.
+// runs in lockstep (the test calls advance() once per servo period), so a
+// reading and the truth of the period it shows are taken together, and a
+// delay is exactly its number of periods.
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "sim/closed_loop.h"
 #include "sim/emulator.h"
 #include "sim/sensor_model.h"
-#include "tests/support/emulator_reading.h"
 
 namespace vmh::sim {
 namespace {
 
-using vmh::testing::matched_reading;
-using vmh::testing::sleep_s;
-
 const std::string kScene = std::string(VMH_MODELS_DIR) + "/cases/case1.xml";
 
+// in lockstep
 EmulatorOptions options(const std::string& seeded,
                         HandProgram hand = HandProgram::kTour) {
   EmulatorOptions o;
+  o.lockstep = true;
   o.scene = kScene;
   o.hand = hand;
   o.seeded = parse_seeded_faults(seeded);
   return o;
+}
+
+// n servo periods, then the reading they end with and the truth of the
+// same period (its timestamp is that truth's publish time)
+void run_and_read(Emulator* emu, long n, DeviceState* s, EmulatorTruth* t) {
+  for (long i = 0; i < n; ++i) emu->advance();
+  ASSERT_EQ(emu->read_state(s), DeviceError::kOk);
+  *t = emu->truth();
+  ASSERT_EQ(s->timestamp_s, t->wall_s);
 }
 
 std::string message_of(const std::string& text) {
@@ -127,10 +135,10 @@ TEST(SeededFaults, MissingModelFileIsNamed) {
 TEST(SeededFaults, SignAndSwapChangeOnlyTheReportedAngles) {
   Emulator emu(options("joint1_sign,gimbal_swap"));
   emu.start();
-  sleep_s(0.3);  // the tour moves every joint away from zero
   DeviceState s;
   EmulatorTruth t;
-  ASSERT_TRUE(matched_reading(&emu, &s, &t));
+  // 0.3 s: the tour moves every joint away from zero
+  ASSERT_NO_FATAL_FAILURE(run_and_read(&emu, 300, &s, &t));
   const OmniParams& p = emu.loop().controller_params().omni;
   const Joints meas = SensorModel(p, true).measure(dh_to_device_joints(t.q_end_dh));
   EXPECT_NEAR(s.q_device_rad[0], -meas[0], 1e-12);
@@ -149,35 +157,38 @@ TEST(SeededFaults, SignAndSwapChangeOnlyTheReportedAngles) {
 }
 
 // delay_5ms: each reading, timestamp included, is the one published 5
-// periods before the newest at the time of the read
+// periods before the newest at the time of the read. In lockstep every
+// period is read and its truth kept, so every reading is matched to its
+// own truth: exactly 5 periods older (the old test, polling a running
+// emulator, matched some 20 of them and allowed 4 or 5).
 TEST(SeededFaults, DelayDeliversReadingsFivePeriodsOld) {
   Emulator emu(options("delay_5ms"));
   emu.start();
-  sleep_s(0.1);
-  const vmh::testing::Polled polled = vmh::testing::poll_emulator(&emu, 0.3);
-  emu.stop();
   const OmniParams& p = emu.loop().controller_params().omni;
   const SensorModel sensor(p, true);
-  int checked = 0;
-  for (const auto& r : polled.reads) {
-    if (r.periods_before != r.periods_after) continue;  // published meanwhile
-    const auto it = std::find_if(polled.truths.begin(), polled.truths.end(),
-                                 [&](const EmulatorTruth& t) {
-                                   return t.wall_s == r.state.timestamp_s;
-                                 });
-    if (it == polled.truths.end()) continue;  // that period was not polled
-    // the truth may run one period ahead of the reading: it is written
-    // just after the reading of the same period
-    const long age = r.periods_before - it->periods;
-    EXPECT_TRUE(age == 5 || age == 4) << age;
-    const Joints meas = sensor.measure(dh_to_device_joints(it->q_end_dh));
-    EXPECT_LE((r.state.q_device_rad - meas).cwiseAbs().maxCoeff(), 1e-12);
-    EXPECT_LE((r.state.transform_mm.topRightCorner<3, 1>() - it->p_end_mm)
-                  .cwiseAbs().maxCoeff(), 1e-9);
-    checked += age == 5 ? 1 : 0;
+  const long n = 400;
+  std::vector<EmulatorTruth> truths;  // truths[k]: the truth of period k
+  truths.reserve(static_cast<std::size_t>(n) + 1);
+  truths.push_back(emu.truth());  // the start state, published at 0
+  for (long k = 1; k <= n; ++k) {
+    emu.advance();
+    truths.push_back(emu.truth());
+    DeviceState s;
+    ASSERT_EQ(emu.read_state(&s), DeviceError::kOk) << k;
+    // until there is a reading 5 periods old, the first one (the start
+    // state), as a device's first readings would be
+    const EmulatorTruth& shown = truths[static_cast<std::size_t>(std::max(0L, k - 5))];
+    ASSERT_EQ(s.timestamp_s, shown.wall_s) << k;
+    const Joints meas = sensor.measure(dh_to_device_joints(shown.q_end_dh));
+    EXPECT_LE((s.q_device_rad - meas).cwiseAbs().maxCoeff(), 1e-12) << k;
+    EXPECT_LE((s.transform_mm.topRightCorner<3, 1>() - shown.p_end_mm)
+                  .cwiseAbs().maxCoeff(), 1e-9) << k;
   }
-  std::printf("  %d readings matched to a truth 5 periods older\n", checked);
-  EXPECT_GT(checked, 20);
+  emu.stop();
+  // and the check tells 5 periods from none: the tour moves the stylus
+  // measurably in 5 periods
+  const Vec3 moved = truths[200].p_end_mm - truths[195].p_end_mm;
+  EXPECT_GT(moved.norm(), 1e-3);
 }
 
 // torque_units_*: the motors hold the written torque times 1000 (clamped to
@@ -200,8 +211,9 @@ TEST(SeededFaults, TorqueUnitsScaleTheAppliedTorque) {
                                m->actuator_ctrlrange[2 * a + 1]);
       }
       ASSERT_EQ(emu.write_motor_torques(tau), DeviceError::kOk);
-      const bool held = vmh::testing::wait_for(
-          [&] { return (emu.truth().motor_torque_Nm - expect).norm() < 1e-12; }, 2.0);
+      // held over the very next period (the old test polled for up to 2 s)
+      emu.advance();
+      const bool held = (emu.truth().motor_torque_Nm - expect).norm() < 1e-12;
       EXPECT_TRUE(held) << name << " tau " << tau.transpose() << ": holds "
                         << emu.truth().motor_torque_Nm.transpose() << ", expected "
                         << expect.transpose();
@@ -214,10 +226,9 @@ TEST(SeededFaults, TorqueUnitsScaleTheAppliedTorque) {
 TEST(SeededFaults, LongerLinkMovesTheReportedTransform) {
   Emulator emu(options("link_length_2pct"));
   emu.start();
-  sleep_s(0.2);
   DeviceState s;
   EmulatorTruth t;
-  ASSERT_TRUE(matched_reading(&emu, &s, &t));
+  ASSERT_NO_FATAL_FAILURE(run_and_read(&emu, 200, &s, &t));
   emu.stop();
   const OmniParams& nominal = emu.loop().controller_params().omni;
   OmniParams longer = nominal;

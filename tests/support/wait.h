@@ -1,5 +1,8 @@
-// Waiting in tests that run against a real-time thread (the emulator, a
-// servo loop): sleep, and poll a condition with a time limit.
+// Waiting in the tests that run against a wall-clock thread: sleep, and
+// poll a condition with a time limit. Only the *Realtime suites need this
+// (emulator_test.cc and emulator_firewire_test.cc, on the emulator's
+// physics thread); every other emulator test runs it in lockstep and has
+// nothing to wait for.
 #ifndef VMHAPTICS_TESTS_SUPPORT_WAIT_H_
 #define VMHAPTICS_TESTS_SUPPORT_WAIT_H_
 
