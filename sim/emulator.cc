@@ -274,9 +274,20 @@ void Emulator::advance() noexcept {
   // when the next tick reads it
   lockstep_periods_.fetch_add(1, std::memory_order_relaxed);
   const double now_s = clock_s();
-  if (now_s <= frozen_until_s_ + 1e-12) return;  // a stall: nothing moves
+  // a stall: nothing moves (times on this clock are whole periods, up to
+  // the rounding of k T: compared with a tolerance far below a period)
+  if (now_s < frozen_until_s_ + time_tolerance_s()) return;
   const double freeze_s = step_period();
-  if (freeze_s > 0.0) frozen_until_s_ = now_s + freeze_s;
+  // the period that met the stall is its first: as on the wall clock, the
+  // physics loses freeze_s of time in all
+  if (freeze_s > 0.0) frozen_until_s_ = now_s + freeze_s - period_s_;
+}
+
+double Emulator::time_tolerance_s() const noexcept {
+  // lockstep times are k T, products whose last bits vary with k: a
+  // millionth of a period tells equal from different. On the wall clock
+  // nothing is exact anyway
+  return options_.lockstep ? 1e-6 * period_s_ : 0.0;
 }
 
 std::string Emulator::stall_cause() const {
@@ -355,12 +366,14 @@ double Emulator::apply_faults(double t_s) noexcept {
         break;
     }
   }
-  if (unplugged_.load(std::memory_order_relaxed) && t_s >= ps.unplug_until_s) {
+  const double tol_s = time_tolerance_s();
+  if (unplugged_.load(std::memory_order_relaxed) &&
+      t_s >= ps.unplug_until_s - tol_s) {
     // replugged: the motors wait for a fresh command
     ps.replug_writes = command_.read().count;
     unplugged_.store(false);
   }
-  if (ps.late_count > 0 && t_s >= ps.late_until_s) ps.late_count = 0;
+  if (ps.late_count > 0 && t_s >= ps.late_until_s - tol_s) ps.late_count = 0;
   return freeze_s;
 }
 
@@ -373,7 +386,7 @@ Vec3 Emulator::motor_command(double now_s) noexcept {
     return Vec3::Zero();
   }
   if (options_.device_watchdog_s > 0.0 &&
-      now_s - c.wall_s > options_.device_watchdog_s) {
+      now_s - c.wall_s > options_.device_watchdog_s + time_tolerance_s()) {
     ps.watchdog_fired = true;
     return Vec3::Zero();
   }
@@ -501,8 +514,12 @@ DeviceError Emulator::read_state(DeviceState* state) noexcept {
     if (drops_.compare_exchange_weak(drops, drops - 1)) return DeviceError::kTimeout;
   }
   const Published p = state_.read();
-  const double stale_s = kStaleReadPeriods * period_s_ / options_.realtime_factor;
-  if (clock_s() - p.publish_wall_s > stale_s) {
+  // three periods of the emulator's own time: of simulated time in
+  // lockstep, of wall time scaled by the real-time factor on the wall clock
+  const double stale_s =
+      kStaleReadPeriods * period_s_ /
+      (options_.lockstep ? 1.0 : options_.realtime_factor);
+  if (clock_s() - p.publish_wall_s > stale_s + time_tolerance_s()) {
     // behind by the host's doing, not a stall fault's: the emulator's own
     // problem (stall_cause), not the device's
     if (!options_.lockstep && !frozen_.load(std::memory_order_relaxed)) {

@@ -342,6 +342,8 @@ class Emulator final : public HapticDevice {
   void run() noexcept;
   // one servo period; returns the seconds to freeze for (a stall), else 0
   double step_period() noexcept;
+  // how far apart two of the clock's times may be and still be equal
+  double time_tolerance_s() const noexcept;
   double apply_faults(double t_s) noexcept;
   Vec3 motor_command(double now_s) noexcept;
   void publish(double now_s) noexcept;

@@ -281,7 +281,9 @@ TransportStatus EmulatorFirewireTransport::receive(std::uint8_t* buf,
   p.counter = counter_;
   p.packet_number = static_cast<std::uint8_t>(counter_ & 0xffu);
   const double us = std::max(0.0, 1e6 * (s.timestamp_s - start_wall_s_));
-  p.time = static_cast<std::uint32_t>(static_cast<std::uint64_t>(us) & 0xffffffffull);
+  // rounded, not truncated: 1.025 s is 1025000 us, not 1024999
+  p.time = static_cast<std::uint32_t>(static_cast<std::uint64_t>(std::llround(us)) &
+                                      0xffffffffull);
 
   std::uint8_t bytes[hw::fw::kStatePacketBytes + 1] = {};
   hw::fw::encode_state(p, bytes);

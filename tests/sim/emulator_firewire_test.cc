@@ -198,9 +198,9 @@ TEST(EmulatorFirewire, PacketsCarryTheEmulatorsRawReadings) {
     EXPECT_EQ(p.magic, kEmulatorStateMagic);
     EXPECT_EQ(p.counter, i);  // one packet a period, none lost
     EXPECT_EQ(p.packet_number, p.counter & 0xffu);
-    // microseconds since start(): i periods of 1 ms (exact here; the field
-    // truncates, so from period 1025 on some packets read 1 us early, see
-    // the report of this change)
+    // microseconds since start(): i periods of 1 ms, rounded to the
+    // microsecond (EmulatorFirewire.TheTimeFieldIsRoundedNotTruncated checks
+    // the periods where truncation would read 1 us early)
     EXPECT_EQ(p.time, 1000u * i);
     // button 2 pressed (bit 1 clear), button 1 not (bit 0 set); the tour
     // keeps the stylus out of the inkwell (bit 2 set)
@@ -479,6 +479,28 @@ TEST(EmulatorFirewire, LatePacketsAreOldThenFreshAgain) {
   t.stop();
 }
 
+// The packet's time field is the emulator's clock in microseconds since
+// start(), rounded: k T for k = 1025 is 1.0249999999999999 s as a double, and
+// a truncating conversion would write 1024999.
+TEST(EmulatorFirewire, TheTimeFieldIsRoundedNotTruncated) {
+  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  Emulator* emu = t.emulator();
+  t.start();
+  std::uint8_t buf[64];
+  std::size_t size = 0;
+  int checked = 0;
+  for (int k = 1; k <= 1100; ++k) {
+    emu->advance();
+    ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kOk) << k;
+    if (k < 1000) continue;
+    const fw::StatePacket p = packet_of(buf, size);
+    EXPECT_EQ(p.time, 1000u * static_cast<unsigned>(k)) << "period " << k;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 101);
+  t.stop();
+}
+
 // A stall: no packets at all (time-outs), and none counted as lost.
 TEST(EmulatorFirewire, StallSendsNothing) {
   EmulatorFirewireTransport t(options(HandProgram::kTour));
@@ -489,29 +511,22 @@ TEST(EmulatorFirewire, StallSendsNothing) {
   DeviceState s;
   ASSERT_EQ(omni.read_state(&s), DeviceError::kOk);
   t.inject({WireFaultKind::kStall, 0.0, 0.3, 0});
-  // The stall's own period and the 300 after it do not step (as in
+  // The stall's own period and the 299 after it do not step (as in
   // emulator_test.cc's StallTimesOutThenRecovers); the last packet ages.
-  // Older than 3 periods a read times out; at exactly 3 rounding decides,
-  // so that read is not asserted.
+  // Older than 3 periods a read times out.
   long timeouts = 0;
-  for (long age = 1; age <= 301; ++age) {
+  for (long age = 1; age <= 300; ++age) {
     emu->advance();
     const DeviceError e = omni.read_state(&s);
-    if (age <= 2) {
+    if (age <= 3) {
       EXPECT_EQ(e, DeviceError::kOk) << age;
-    }
-    if (age >= 4) {
+    } else {
       EXPECT_EQ(e, DeviceError::kTimeout) << age;
       timeouts += e == DeviceError::kTimeout ? 1 : 0;
     }
-    if (age == 3) {
-      EXPECT_TRUE(e == DeviceError::kOk || e == DeviceError::kTimeout)
-          << device_error_name(e);
-    }
   }
-  EXPECT_EQ(timeouts, 298);  // the old test waited for one
-  EXPECT_GE(omni.stats().timeouts, 298u);
-  EXPECT_LE(omni.stats().timeouts, 299u);
+  EXPECT_EQ(timeouts, 297);  // the old test waited for one
+  EXPECT_EQ(omni.stats().timeouts, 297u);
   // the next period steps: data again (the old test waited up to 2 s)
   emu->advance();
   EXPECT_EQ(omni.read_state(&s), DeviceError::kOk);

@@ -329,8 +329,8 @@ TEST(EmulatorSafety, WatchdogZeroesTorqueWhenTheLoopStops) {
   for (int i = 0; i < 8; ++i) rig.emu().advance();
   EXPECT_FALSE(rig.safety().service_watchdog(rig.emu().clock_s()));
   EXPECT_TRUE(holds(rig.held(), kSmall));
-  // ... 11 are past them (exactly 10 would be decided by rounding, as with
-  // the device watchdog in emulator_test.cc); the old test waited 30
+  // ... 11 are past them (exactly 10 would be decided by the last bits of
+  // the layer's own sum of time stamps); the old test waited 30
   rig.emu().advance();
   rig.emu().advance();
   EXPECT_TRUE(rig.safety().service_watchdog(rig.emu().clock_s()));

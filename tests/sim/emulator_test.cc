@@ -9,10 +9,11 @@
 // falls on a known period: the tests assert exact counts and values, and
 // their verdicts do not depend on how busy the machine is.
 //
-// Fault durations are given half a period off the period grid (0.3005 s,
-// not 0.3 s): a fault ends at the first period start at or past its end,
-// and a sum of periods that lands exactly on that end compares one way or
-// the other by rounding. Off the grid, the count of periods is exact.
+// A fault ends at the first period start at or past its end. The emulator
+// compares times on its lockstep clock with a tolerance of a millionth of a
+// period, so a duration of a whole number of periods (StallTimesOut-
+// ThenRecovers' 0.3 s) ends exactly on its period; most tests give theirs
+// half a period off the grid (0.3005 s), where no rounding could matter.
 //
 // EmulatorRealtime runs the physics thread on the wall clock, for what only
 // it can show: it keeps its period beside a servo thread, stop() joins
@@ -247,9 +248,8 @@ TEST(Emulator, NonFiniteWriteHoldsZeroTorque) {
 TEST(Emulator, DeviceWatchdogZeroesTorqueWithoutWrites) {
   EmulatorOptions o = options(HandProgram::kNone);
   // The watchdog fires in a period that starts more than this after the
-  // last write. 50.5 periods: at exactly 50 (0.05 s) the comparison of two
-  // clock readings would be decided by rounding (see the report of this
-  // change); half a period off, the period it fires in is exact.
+  // last write: 50.5 periods, half a period off the grid, so that it fires
+  // in the period after the 50th whatever the clock's last bits.
   o.device_watchdog_s = 0.0505;
   Emulator emu(o);
   emu.start();
@@ -330,30 +330,24 @@ TEST(Emulator, StallTimesOutThenRecovers) {
   run(&emu, 20);
   emu.inject({EmulatorFaultKind::kStall, 0.0, 0.3, 0});
   // The stall is taken at the next period's start, which therefore does not
-  // step; nor do the periods of the next 0.3 s of the clock (a multiple of
-  // the period is exact here: the emulator compares the stall's end with a
-  // tolerance). 1 + 300 periods without a step, the reading of period 20
-  // ageing meanwhile.
-  const long frozen = 301;
+  // step; nor do the following ones until 0.3 s of the clock have passed in
+  // all, as on the wall clock: 300 periods without a step, the reading of
+  // period 20 ageing meanwhile (the emulator compares times on its clock
+  // with a tolerance far below a period, so a whole number of periods is
+  // exact).
+  const long frozen = 300;
   long timeouts = 0;
   DeviceState s;
   for (long age = 1; age <= frozen; ++age) {
     emu.advance();
     ASSERT_EQ(emu.truth().periods, 20) << age;  // nothing stepped
     const DeviceError e = emu.read_state(&s);
-    // A reading times out once older than 3 periods. Exactly 3 periods old,
-    // the difference of two clock readings decides by rounding (see the
-    // report of this change), so that one read is not asserted.
-    if (age <= 2) {
+    // a reading times out once more than 3 periods old
+    if (age <= 3) {
       EXPECT_EQ(e, DeviceError::kOk) << age;
-    }
-    if (age >= 4) {
+    } else {
       EXPECT_EQ(e, DeviceError::kTimeout) << age;
       timeouts += e == DeviceError::kTimeout ? 1 : 0;
-    }
-    if (age == 3) {
-      EXPECT_TRUE(e == DeviceError::kOk || e == DeviceError::kTimeout)
-          << device_error_name(e);
     }
   }
   EXPECT_EQ(timeouts, frozen - 3);  // the old test asked for more than 10
@@ -539,6 +533,26 @@ TEST(Emulator, RawReadingsDecodeToTheReportedAngles) {
 // In lockstep stall_cause() has nothing to report: there is no wall clock
 // for the physics to fall behind, and a time-out is the device's own (here
 // an injected stall), never the emulator's.
+// In lockstep a reading's age is counted in the emulator's own periods,
+// whatever the real-time factor (which scales only the wall clock): one to
+// three periods old it is fresh, four it is stale.
+TEST(Emulator, LockstepStalenessIgnoresTheRealtimeFactor) {
+  EmulatorOptions o = options(HandProgram::kTour);
+  o.realtime_factor = 4.0;
+  Emulator emu(o);
+  emu.start();
+  run(&emu, 10);
+  emu.inject({EmulatorFaultKind::kStall, 0.0, 0.1, 0});
+  DeviceState s;
+  for (int age = 1; age <= 6; ++age) {
+    emu.advance();
+    EXPECT_EQ(emu.read_state(&s),
+              age <= 3 ? DeviceError::kOk : DeviceError::kTimeout)
+        << "a reading " << age << " periods old";
+  }
+  emu.stop();
+}
+
 TEST(Emulator, StallCauseIsEmptyInLockstep) {
   Emulator emu(options(HandProgram::kTour));
   emu.start();
@@ -599,11 +613,11 @@ TEST(NoAlloc, EmulatorAdvanceReadWrite) {
   EXPECT_EQ(allocations, 0u);
   EXPECT_EQ(other, 0);
   // every fault was taken and read through inside the scope
-  // 3 drops; the stall: its own period and 20 more without a step, the
-  // reading 1 to 21 periods old, a time-out from 4 periods (at exactly 3
-  // by rounding, as in StallTimesOutThenRecovers)
-  EXPECT_GE(timeouts, 3 + 18);
-  EXPECT_LE(timeouts, 3 + 19);
+  // the 3 drops go to the next 3 reads, and each tick reads twice
+  // (read_state, then read_joints): 2 of them land on read_state. The
+  // stall: 20 periods without a step (its own and 19 more), the reading 1
+  // to 20 periods old, a time-out from 4 periods: 17
+  EXPECT_EQ(timeouts, 2 + 17);
   EXPECT_EQ(not_connected, 21);  // the unplug: 21 periods
   EXPECT_EQ(late, 51);           // the late fault: 51 periods
   EXPECT_EQ(ok + timeouts + not_connected, 5 * 150);
