@@ -42,6 +42,9 @@ class TempMjcfDir {
     return p.string();
   }
 
+  // the directory itself
+  const std::filesystem::path& path() const { return dir_; }
+
  private:
   std::filesystem::path dir_;
 };
