@@ -1,6 +1,9 @@
 #include "studies/run_case.h"
 
 #include <algorithm>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -143,23 +146,41 @@ int kept_every(const ClosedLoop& loop) {
       std::max<std::int64_t>(1, (n + kMaxKeptTicks - 1) / kMaxKeptTicks));
 }
 
+// Whether the claims can read a tick at time t_s (studies/claims.cc reads
+// the settled half of its windows' segments, and the whole sweep): the
+// other sides' runs keep only those, which the claims then measure exactly
+// as on every tick.
+bool claims_read(const HandScript& script, double t_s) {
+  const ScriptSegment& seg =
+      script.segments()[static_cast<std::size_t>(script.segment_at(t_s))];
+  return seg.name == "sweep" || t_s >= seg.settled_from_s();
+}
+
 // the loop to its end, with the reference controller where the case's
 // claims compare with case 2's gains. Every tick goes to `trace` (if set) as
 // it is made; every kept_every()-th is kept and returned, so memory stays
-// flat however long the run.
+// flat however long the run; with `claims_only`, only those of them the
+// claims read.
 std::vector<TickRecord> run_to_end(ClosedLoop* loop, const StopFn& stop,
-                                 runtime::TraceWriter* trace = nullptr,
-                                 MetricsAccumulator* metrics = nullptr) {
+                                   runtime::TraceWriter* trace = nullptr,
+                                   MetricsAccumulator* metrics = nullptr,
+                                   bool claims_only = false) {
   const int thesis_case = loop->config().thesis_case;
   if (auto ref = reference_params(thesis_case, loop->controller_params())) {
     loop->set_reference(*ref);
   }
   const int every = kept_every(*loop);
-  // with servo jitter the number of ticks is not known ahead: run until the
-  // simulated time is up
+  const HandScript& script = loop->script();
+  const double T = loop->controller_params().servo_period_s;
+  // room for what will be kept (with servo jitter the ticks' times are not
+  // known ahead: the count at the nominal period, which the vector may
+  // outgrow a little)
+  std::int64_t expect = 0;
+  for (std::int64_t k = 0; k < loop->ticks_per_run(); k += every) {
+    if (!claims_only || claims_read(script, static_cast<double>(k) * T)) ++expect;
+  }
   std::vector<TickRecord> rows;
-  rows.reserve(static_cast<std::size_t>(std::min<std::int64_t>(
-      kMaxKeptTicks + 1, loop->ticks_per_run() / every + 1)));
+  rows.reserve(static_cast<std::size_t>(std::min<std::int64_t>(kMaxKeptTicks + 1, expect + 1)));
   TickRecord row;
   std::int64_t n = 0;
   // a bad physics state (NaN, inf or beyond 1e10, which MuJoCo resets)
@@ -170,7 +191,9 @@ std::vector<TickRecord> run_to_end(ClosedLoop* loop, const StopFn& stop,
     loop->throw_if_physics_fault();
     if (trace) trace->add(row);
     if (metrics) metrics->add(row);
-    if (n++ % every == 0) rows.push_back(row);
+    if (n++ % every == 0 && (!claims_only || claims_read(script, row.t_s))) {
+      rows.push_back(row);
+    }
   }
   return rows;
 }
@@ -249,7 +272,8 @@ CaseResult run_case(const std::string& name, const std::string& scene,
       std::vector<std::string> o = overrides;
       o.insert(o.end(), extra.begin(), extra.end());
       ClosedLoop l(scene, o, omni_model_hook(model_file));
-      const std::vector<TickRecord> r = run_to_end(&l, should_stop);
+      const std::vector<TickRecord> r =
+          run_to_end(&l, should_stop, nullptr, nullptr, /*claims_only=*/true);
       return evaluate_claims(thesis_case, r, l);
     };
     // a side's label from where its start pose is (device frame: x right,
@@ -384,6 +408,11 @@ void run_cases(std::vector<CaseJob>* jobs,
                  } catch (const std::exception& e) {
                    job.error = e.what();
                  }
+#ifdef __GLIBC__
+                 // a case's rows and models are freed: give the pages back,
+                 // rather than let each thread's arena keep its peak
+                 malloc_trim(0);
+#endif
                  if (progress) progress(++finished, jobs->size());
                });
 }
