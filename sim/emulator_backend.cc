@@ -350,36 +350,31 @@ const std::vector<runtime::BackendOption>& emulator_option_list() {
 }  // namespace
 
 void register_backends(runtime::BackendRegistry* registry) {
-  runtime::BackendInfo emu;
-  emu.name = "emulator";
-  emu.grammar = "emulator[:case|scene.xml]";
-  emu.summary = "the MuJoCo Omni held by a simulated hand";
-  emu.options = emulator_option_list();
-  emu.simulated = true;
-  emu.list = [] {
-    return Json{{"available", true},
-                {"found", "the MuJoCo Omni, scenes in " + models_dir()},
-                {"clocks", {"realtime", "lockstep"}},
-                {"verified_on_hardware", false}};
+  const auto add = [registry](const char* name, const char* summary,
+                              const char* found,
+                              runtime::OpenedDevice (*open)(const OpenRequest&)) {
+    runtime::BackendInfo b;
+    b.name = name;
+    b.grammar = std::string(name) + "[:case|scene.xml]";
+    b.summary = summary;
+    b.options = emulator_option_list();
+    b.simulated = true;
+    const std::string where = found;
+    b.list = [where] {
+      return Json{{"available", true},
+                  {"found", where},
+                  {"clocks", {"realtime", "lockstep"}},
+                  {"verified_on_hardware", false}};
+    };
+    b.open = open;
+    registry->add(std::move(b));
   };
-  emu.open = open_emulator;
-  registry->add(std::move(emu));
-
-  runtime::BackendInfo fw;
-  fw.name = "emulator:firewire";
-  fw.grammar = "emulator:firewire[:case|scene.xml]";
-  fw.summary = "the MuJoCo Omni behind the FireWire Omni's packets";
-  fw.options = emulator_option_list();
-  fw.simulated = true;
-  fw.list = [] {
-    return Json{{"available", true},
-                {"found", "the MuJoCo Omni behind the FireWire Omni's packets "
-                          "and the native driver, in process"},
-                {"clocks", {"realtime", "lockstep"}},
-                {"verified_on_hardware", false}};
-  };
-  fw.open = open_emulator_firewire;
-  registry->add(std::move(fw));
+  add("emulator", "the MuJoCo Omni held by a simulated hand",
+      ("the MuJoCo Omni, scenes in " + models_dir()).c_str(), open_emulator);
+  add("emulator:firewire", "the MuJoCo Omni behind the FireWire Omni's packets",
+      "the MuJoCo Omni behind the FireWire Omni's packets and the native "
+      "driver, in process",
+      open_emulator_firewire);
 }
 
 }  // namespace vmh::sim

@@ -115,32 +115,39 @@ const char* fault_layer_name(FaultLayer layer) {
   return "?";
 }
 
-std::string fault_forms(FaultLayer layer) {
+namespace {
+
+// a kind as it is written: its name, and for a timed kind @t and its fields
+std::string written_form(const FaultKind& k) {
+  std::string form = k.name;
+  if (k.timed) {
+    form += "@t";
+    for (const FaultField& f : k.fields) form += std::string(":") + f.unit;
+  }
+  return form;
+}
+
+// the written forms of a layer's kinds, each followed by `more(kind)`,
+// joined by `sep`
+template <typename More>
+std::string list_kinds(FaultLayer layer, const char* sep, More more) {
   std::string s;
   for (const FaultKind& k : fault_kinds()) {
     if (!(k.layers & layer)) continue;
-    std::string form = k.name;
-    if (k.timed) {
-      form += "@t";
-      for (const FaultField& f : k.fields) form += std::string(":") + f.unit;
-    }
-    s += (s.empty() ? "" : ", ") + form;
+    s += (s.empty() ? "" : sep) + written_form(k) + more(k);
   }
   return s;
 }
 
+}  // namespace
+
+std::string fault_forms(FaultLayer layer) {
+  return list_kinds(layer, ", ", [](const FaultKind&) { return std::string(); });
+}
+
 std::string fault_help(FaultLayer layer) {
-  std::string s;
-  for (const FaultKind& k : fault_kinds()) {
-    if (!(k.layers & layer)) continue;
-    std::string form = k.name;
-    if (k.timed) {
-      form += "@t";
-      for (const FaultField& f : k.fields) form += std::string(":") + f.unit;
-    }
-    s += (s.empty() ? "" : "; ") + form + ": " + k.doc;
-  }
-  return s;
+  return list_kinds(layer, "; ",
+                    [](const FaultKind& k) { return std::string(": ") + k.doc; });
 }
 
 std::vector<FaultItem> parse_faults(const std::string& text, FaultLayer layer) {
@@ -208,9 +215,7 @@ std::vector<FaultItem> parse_faults(const std::string& text, FaultLayer layer) {
     std::vector<std::string> values;
     if (k.timed) {
       if (parts.size() != 1 + k.fields.size()) {
-        std::string form = std::string(k.name) + "@t";
-        for (const FaultField& f : k.fields) form += std::string(":") + f.unit;
-        fail(std::string(k.name) + " takes " + form);
+        fail(std::string(k.name) + " takes " + written_form(k));
       }
       values.assign(parts.begin() + 1, parts.end());
       char* end = nullptr;
