@@ -137,6 +137,13 @@ SessionResult run_session(OpenedDevice* dev, const SessionOptions& o) {
   Recorder recorder(o, *dev, &r);
   StopSignals signals;
   r.servo_report = backend.start(&loop, o.servo);
+  // whatever leaves this function from here on (a callback that throws,
+  // memory running out), the loop is stopped before it is destroyed, and
+  // the device left at zero torque
+  struct StopOnExit {
+    DeviceBackend* backend;
+    ~StopOnExit() { backend->stop(); }
+  } stop_on_exit{&backend};
 
   TickRecord rec;
   double next_progress_s = 1.0;
