@@ -36,13 +36,20 @@ struct Slot {
 };
 std::array<Slot, SimHand::kMaxHands> g_slots;
 std::mutex g_registry_mutex;
+// the callback another copy of this file installed before ours (a plugin
+// that links the testbed, e.g. libHD.so over the emulator, in the same
+// process as the command line): data this copy does not know goes to it
+std::atomic<mjfGeneric> g_next{nullptr};
+// set while this copy hands a call on, so that two copies chained to each
+// other stop after one round for data neither knows
+thread_local bool t_handing_on = false;
 
 void register_hand(const mjData* d, SimHand* hand, const std::string& source) {
   std::lock_guard<std::mutex> lock(g_registry_mutex);
   if (mjcb_control != nullptr && mjcb_control != hand_control_callback) {
-    throw SimError(source +
-                   ": mjcb_control is set by other code; the simulated hand "
-                   "owns it (sim/hand.h)");
+    // another copy of the hand's code (its callback chains in turn) or
+    // someone else's: ours goes first and hands the rest on
+    g_next.store(mjcb_control, std::memory_order_release);
   }
   Slot* free_slot = nullptr;
   for (Slot& s : g_slots) {
@@ -72,7 +79,9 @@ void unregister_hand(const mjData* d) {
   // the last hand gone: hand the callback back, so that other code in the
   // process (another copy of this library inside a plugin, e.g. the test
   // libHD.so over the emulator) may install its own
-  if (!any && mjcb_control == hand_control_callback) mjcb_control = nullptr;
+  if (!any && mjcb_control == hand_control_callback) {
+    mjcb_control = g_next.exchange(nullptr, std::memory_order_acq_rel);
+  }
 }
 
 }  // namespace
@@ -88,7 +97,16 @@ SimHand* registered_hand(const mjData* d) {
 
 void hand_control_callback(const mjModel* m, mjData* d) {
   SimHand* hand = registered_hand(d);
-  if (hand != nullptr) hand->apply(m, d);
+  if (hand != nullptr) {
+    hand->apply(m, d);
+    return;
+  }
+  const mjfGeneric next = g_next.load(std::memory_order_acquire);
+  if (next != nullptr && !t_handing_on) {
+    t_handing_on = true;
+    next(m, d);
+    t_handing_on = false;
+  }
 }
 
 HandParams hand_params(const CaseParams& c) {

@@ -17,8 +17,11 @@
 // the hand registered for the data being stepped (and does nothing for data
 // without one). So the physics of a scene is the same whoever calls mj_step
 // or mj_forward on its data (the closed loop, a viewer, a test), in any
-// thread, and nobody sets mjcb_control per tick. A SimHand refuses to be
-// built if some other code already owns mjcb_control. While a hand is
+// thread, and nobody sets mjcb_control per tick. Where other code owns
+// mjcb_control already (another copy of this file: libHD.so over the
+// emulator, loaded by the command line), the first SimHand keeps that
+// callback and hands it the data it has no hand for; the last one gone
+// puts it back. While a hand is
 // registered, d->qfrc_applied is the hand's: it is overwritten at every
 // evaluation.
 #ifndef VMHAPTICS_SIM_HAND_H_
@@ -64,8 +67,8 @@ class SimHand {
   // mass to the grip's body, recomputes the model's constants
   // (mj_setConst), and registers itself as the hand of `d` (see above).
   // Throws SimError naming what is missing, if `d` already has a hand, if
-  // too many hands are registered at once (kMaxHands), or if mjcb_control
-  // belongs to someone else. `m` and `d` must outlive the hand.
+  // too many hands are registered at once (kMaxHands). `m` and `d` must
+  // outlive the hand.
   SimHand(mjModel* m, mjData* d, const HandParams& params,
           const std::string& source);
   // unregisters: stepping `d` afterwards applies no hand
