@@ -148,6 +148,13 @@ void hw_run(const HwRunArgs& a) {
   Json summary{{"case", name}, {"scene", scene}};
   Json measured;
 #ifdef VMH_HAVE_SIM
+  // a device that is not the emulator but has a simulated plant's truth
+  // behind it (the project's own HD library over the emulator,
+  // docs/libhd.md): its claims are judged as the emulator's are
+  if (!run_case && dev.truth != nullptr) {
+    run_case = std::make_unique<studies::HwRunCase>(scene, sets, model_file,
+                                                    a.gain_scale);
+  }
   if (run_case) measured = run_case->run(&dev, so, &r);
 #endif
   if (measured.is_null()) {

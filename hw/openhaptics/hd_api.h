@@ -147,6 +147,10 @@ typedef HDSchedulerHandle (*PfnScheduleAsynchronous)(HDSchedulerCallback cb,
 typedef void (*PfnScheduleSynchronous)(HDSchedulerCallback cb,
                                        void* user_data, HDushort priority);
 typedef void (*PfnUnschedule)(HDSchedulerHandle handle);
+// the project's own library's extension (include/HD/vmhd.h, docs/libhd.md):
+// absent from the vendor's
+typedef HDdouble (*PfnVmhdSchedulerTime)();
+typedef int (*PfnVmhdReadTruth)(HHD h, void* truth, unsigned long size);
 }  // extern "C"
 
 // Every function the backend calls, resolved from one loaded library.
@@ -173,6 +177,9 @@ struct HdApi {
   PfnScheduleAsynchronous hdScheduleAsynchronous = nullptr;
   PfnScheduleSynchronous hdScheduleSynchronous = nullptr;
   PfnUnschedule hdUnschedule = nullptr;
+  // optional: only the project's open HD API has them (nullptr otherwise)
+  PfnVmhdSchedulerTime vmhdGetSchedulerTime = nullptr;
+  PfnVmhdReadTruth vmhdReadTruth = nullptr;
 };
 
 }  // namespace vmh::hw::hd

@@ -95,6 +95,12 @@ HdLibrary::HdLibrary(const std::string& file_in) {
   VMH_HD_RESOLVE(hdScheduleSynchronous);
   VMH_HD_RESOLVE(hdUnschedule);
 #undef VMH_HD_RESOLVE
+  // the project's extension, where the library is the project's own
+  api_.vmhdGetSchedulerTime = reinterpret_cast<PfnVmhdSchedulerTime>(
+      dlsym(handle_, "vmhdGetSchedulerTime"));
+  api_.vmhdReadTruth =
+      reinterpret_cast<PfnVmhdReadTruth>(dlsym(handle_, "vmhdReadTruth"));
+  dlerror();
 }
 
 HdLibrary::~HdLibrary() {

@@ -174,7 +174,7 @@ void OpenHapticsBackend::read_frame_state() noexcept {
       gimbal_rad[1], gimbal_rad[2];
   s.present = kStateJoints | kStateButtons | kStateTimestamp |
               kStateTransform | kStateVelocity | kStateJacobian;
-  s.timestamp_s = monotonic_now_s();
+  s.timestamp_s = frame_time_s();
   HDint buttons = 0;
   api_->hdGetIntegerv(kCurrentButtons, &buttons);
   s.buttons = buttons_from_hd(buttons);
@@ -266,10 +266,11 @@ HDCallbackCode OpenHapticsBackend::servo_callback(void* self) noexcept {
   api.hdBeginFrame(b->handle_);
   b->drain_errors();  // a device that stopped answering says so here
   b->read_frame_state();
-  const double now_s = monotonic_now_s();
+  const double now_s = b->frame_time_s();
+  const double work_start_s = monotonic_now_s();
   b->timer_.begin(now_s);
   const bool go_on = b->loop_->tick(now_s);
-  b->timer_.end(monotonic_now_s());
+  b->timer_.end(now_s + (monotonic_now_s() - work_start_s));
   // the last frame of a loop that ended, and every frame after a fatal
   // error, sends zero
   const bool zero = !go_on || b->fault_.load(std::memory_order_relaxed) != 0;
@@ -282,6 +283,16 @@ HDCallbackCode OpenHapticsBackend::servo_callback(void* self) noexcept {
     return kCallbackDone;
   }
   return kCallbackContinue;
+}
+
+double OpenHapticsBackend::frame_time_s() const noexcept {
+  return api_->vmhdGetSchedulerTime != nullptr ? api_->vmhdGetSchedulerTime()
+                                               : monotonic_now_s();
+}
+
+bool OpenHapticsBackend::read_truth(PlantTruth* truth) const noexcept {
+  if (api_->vmhdReadTruth == nullptr || handle_ == kInvalidHandle) return false;
+  return api_->vmhdReadTruth(handle_, truth, sizeof(PlantTruth)) == 1;
 }
 
 HDCallbackCode OpenHapticsBackend::zero_callback(void* self) noexcept {

@@ -24,6 +24,7 @@
 
 #include "controller/omni_params.h"
 #include "device/device_backend.h"
+#include "device/tick_record.h"
 #include "device/tick_timer.h"
 #include "hw/openhaptics/hd_api.h"
 #include "hw/openhaptics/hd_codec.h"
@@ -114,6 +115,12 @@ class OpenHapticsBackend final : public DeviceBackend {
   bool has_inkwell() const noexcept { return has_inkwell_; }
   const Options& options() const noexcept { return options_; }
 
+  // The simulated plant's truth behind the project's own HD library
+  // (vmhdReadTruth, docs/libhd.md); false for any other library. Called
+  // from the servo loop (the session reads it after each tick).
+  bool has_truth() const noexcept { return api_->vmhdReadTruth != nullptr; }
+  bool read_truth(PlantTruth* truth) const noexcept;
+
  private:
   // the device() the loop sees: the frame's state and the torque to send
   class FrameDevice final : public HapticDevice {
@@ -132,6 +139,10 @@ class OpenHapticsBackend final : public DeviceBackend {
   static hd::HDCallbackCode calibration_callback(void* self) noexcept;
 
   void read_frame_state() noexcept;
+  // the tick's time, s: the scheduler's own (vmhdGetSchedulerTime, which
+  // in lockstep is the simulated time) where the library has it, else
+  // CLOCK_MONOTONIC
+  double frame_time_s() const noexcept;
   void send_torque(const Vec3& tau_motor_Nm) noexcept;
   void drain_errors() noexcept;
   // the first error code pending after a setup call (kSuccess if none); the

@@ -8,6 +8,18 @@
 namespace vmh::hw {
 namespace {
 
+// the plant's truth behind the project's own HD library
+class HdTruth final : public runtime::TruthSource {
+ public:
+  explicit HdTruth(const OpenHapticsBackend* b) : b_(b) {}
+  void read_truth(PlantTruth* truth) const noexcept override {
+    if (!b_->read_truth(truth)) *truth = PlantTruth{};
+  }
+
+ private:
+  const OpenHapticsBackend* b_;
+};
+
 runtime::OpenedDevice open_openhaptics(const runtime::OpenRequest& rq) {
   OpenHapticsOptions ho;
   ho.config = rq.argument;
@@ -18,7 +30,18 @@ runtime::OpenedDevice open_openhaptics(const runtime::OpenRequest& rq) {
     throw runtime::RequestError(std::string("--hd-command: ") + e.what());
   }
   runtime::OpenedDevice dev;
-  dev.backend = std::make_unique<OpenHapticsBackend>(ho);
+  auto backend = std::make_unique<OpenHapticsBackend>(ho);
+  if (backend->has_truth()) {
+    // the project's own library over a simulated device: the claims can be
+    // judged on its truth, as on the emulator
+    PlantTruth probe;
+    if (backend->read_truth(&probe)) {
+      auto truth = std::make_shared<HdTruth>(backend.get());
+      dev.truth = truth.get();
+      dev.keep = truth;
+    }
+  }
+  dev.backend = std::move(backend);
   dev.calibration_source = "the OpenHaptics driver (hdCheckCalibration)";
   return dev;
 }
