@@ -64,6 +64,8 @@ FirewireOmni::FirewireOmni(Transport* transport,
   }
   options_.validate();
   cal_.write(options_.calibration);
+  cal_local_ = options_.calibration;
+  in_use_.write(options_.calibration);
   calibrated_.store(options_.calibrated, std::memory_order_release);
   stats_.write(s_);
   last_.write(StatePacket{});
@@ -72,7 +74,18 @@ FirewireOmni::FirewireOmni(Transport* transport,
 void FirewireOmni::set_calibration(const OmniCalibration& cal) {
   cal.validate();
   cal_.write(cal);
+  cal_gen_.fetch_add(1, std::memory_order_acq_rel);
   calibrated_.store(true, std::memory_order_release);
+}
+
+OmniCalibration FirewireOmni::calibration() const noexcept {
+  // the servo loop's copy once it has taken the latest set_calibration()
+  const std::uint64_t set = cal_gen_.load(std::memory_order_acquire);
+  if (in_use_gen_.load(std::memory_order_acquire) == set) {
+    const OmniCalibration c = in_use_.read();
+    if (in_use_gen_.load(std::memory_order_acquire) == set) return c;
+  }
+  return cal_.read();
 }
 
 DeviceError FirewireOmni::read_joints(Joints* q_device_rad) noexcept {
@@ -135,6 +148,31 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
   }
   have_counts_ = true;
   last_.write(p);
+
+  // the calibration in use: a newly set one, the inkwell's offsets
+  bool changed = false;
+  const std::uint64_t gen = cal_gen_.load(std::memory_order_acquire);
+  if (gen != cal_local_gen_) {
+    cal_local_ = cal_.read();
+    cal_local_gen_ = gen;
+    changed = true;
+  }
+  const bool docked = p.docked();
+  bool rehomed = false;
+  if (options_.rehome_in_inkwell && docked) {
+    const std::array<double, 3> off = docked_encoder_offsets(counts_, cal_local_);
+    if (off != cal_local_.encoder_offset_rad) {
+      cal_local_.encoder_offset_rad = off;
+      changed = true;
+      rehomed = true;
+    }
+    if (!was_docked_) ++s_.rehomes;
+  }
+  was_docked_ = docked;
+  if (changed) {
+    in_use_.write(cal_local_);
+    in_use_gen_.store(cal_local_gen_, std::memory_order_release);
+  }
   publish();
 
   PotCodes pots{};
@@ -143,10 +181,11 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
     if (pots[i] < 0) return DeviceError::kSensorFault;  // an open pot
   }
 
-  state->q_device_rad = angles_from_raw(counts_, pots, cal_.read());
+  state->q_device_rad = angles_from_raw(counts_, pots, cal_local_);
   state->buttons = (p.button1_pressed() ? kButton1 : 0u) |
                    (p.button2_pressed() ? kButton2 : 0u);
-  state->docked = p.docked();
+  state->docked = docked;
+  state->rehomed = rehomed;
   state->timestamp_s = monotonic_now_s();
   state->encoder_counts = counts_;
   state->gimbal_pots = pots;
