@@ -95,8 +95,9 @@ DeviceError FirewireOmni::read_joints(Joints* q_device_rad) noexcept {
 DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
   state->present = 0;
   std::size_t size = 0;
+  ReceiveInfo info;
   const TransportStatus ts = transport_->receive(
-      rx_.data(), rx_.size(), &size, options_.receive_timeout_s);
+      rx_.data(), rx_.size(), &size, options_.receive_timeout_s, &info);
   switch (ts) {
     case TransportStatus::kOk:
       break;
@@ -105,10 +106,13 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
       publish();
       return DeviceError::kTimeout;
     case TransportStatus::kBusReset:
-      // The node id and the iso channels may have changed: find the node
-      // again and restart it. This tick has no reading either way, and the
-      // counts after the reset need not continue the ones before it.
+      // The node id and the iso channels may have changed: zero words with
+      // the motors off for whatever the device takes meanwhile, then find
+      // the node again and restart it. This tick has no reading either
+      // way, and the counts after the reset need not continue the ones
+      // before it.
       ++s_.bus_resets;
+      send_zero();
       if (transport_->recover() != TransportStatus::kOk) {
         ++s_.recoveries_failed;
       }
@@ -133,11 +137,15 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
     return DeviceError::kIo;
   }
   ++s_.packets;
+  const std::uint32_t arrived = info.packets > 0 ? info.packets : 1u;
+  s_.superseded_packets += arrived - 1u;
+  s_.late_packets += info.late;
   if (have_counter_) {
-    // a gap of k means k packets were never seen; a counter that went
-    // backwards (a restarted device) is not a loss
-    const std::uint32_t gap = p.counter - s_.last_counter - 1u;
-    if (gap < 0x80000000u) s_.lost_packets += gap;
+    // The counter moves one a packet. A step of k with `arrived` packets
+    // taken means k - arrived were sent and never arrived; a counter that
+    // went backwards (a restarted device) is not a loss.
+    const std::uint32_t step = p.counter - s_.last_counter;
+    if (step < 0x80000000u && step > arrived) s_.lost_packets += step - arrived;
   }
   have_counter_ = true;
   s_.last_counter = p.counter;

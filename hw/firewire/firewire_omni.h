@@ -8,16 +8,21 @@
 //                             the device convention, lost-packet and
 //                             bus-reset handling; the servo thread
 //
-// read_state(): one receive() (at most options.receive_timeout_s), decoded
-// to encoder counts (unwrapped from int16 to int32 across packets), pot
-// codes (pot_code of the a/b words), buttons, the inkwell switch and a
-// CLOCK_MONOTONIC timestamp; then angles_from_raw() with the calibration.
-// Fills kStateJoints | kStateButtons | kStateInkwell | kStateTimestamp |
-// kStateEncoders | kStatePots. Maps TransportStatus to DeviceError:
-// kTimeout -> kTimeout, kBusReset -> recover() then kNotConnected for this
-// tick (the encoder unwrap is re-seeded from the next packet),
-// kDisconnected -> kNotConnected, kIo / kBadPacket -> kIo. A pot that reads
-// open (a + b = 0) is kSensorFault.
+// read_state(): one receive() (at most options.receive_timeout_s), which
+// takes every packet that arrived since the last tick and hands over the
+// newest; decoded to encoder counts (unwrapped from int16 to int32 across
+// packets), pot codes (pot_code of the a/b words), buttons, the inkwell
+// switch and a CLOCK_MONOTONIC timestamp; then angles_from_raw() with the
+// calibration. Fills kStateJoints | kStateButtons | kStateInkwell |
+// kStateTimestamp | kStateEncoders | kStatePots. Counts, from the device's
+// packet counter and what the transport says arrived: lost packets (the
+// counter moved further than the packets that arrived: the bus lost them),
+// superseded ones (arrived, a newer one was used) and late ones (arrived a
+// tick late). Maps TransportStatus to DeviceError: kTimeout -> kTimeout,
+// kBusReset -> zero words with the motors off, recover(), kNotConnected
+// for this tick (the encoder unwrap is re-seeded from the next packet),
+// kDisconnected -> kNotConnected, kIo / kBadPacket -> kIo. A pot that
+// reads open (a + b = 0) is kSensorFault.
 //
 // Re-homing (options.rehome_in_inkwell, on by default, as the public
 // drivers do it): every packet that says the stylus is in the inkwell sets
@@ -107,8 +112,10 @@ struct FirewireOmniOptions {
 
 // What the device layer counted (safe to read from any thread).
 struct FirewireOmniStats {
-  std::uint64_t packets = 0;        // state packets decoded
-  std::uint64_t lost_packets = 0;   // counter gaps between decoded packets
+  std::uint64_t packets = 0;        // state packets decoded (one a tick)
+  std::uint64_t lost_packets = 0;   // sent by the device, never arrived
+  std::uint64_t superseded_packets = 0;  // arrived, a newer one was used
+  std::uint64_t late_packets = 0;   // arrived a tick late (ReceiveInfo)
   std::uint64_t rehomes = 0;        // times the stylus went into the inkwell
                                     // and the encoder offsets were set
   std::uint64_t bad_packets = 0;    // refused by the codec or the transport

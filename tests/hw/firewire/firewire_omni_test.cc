@@ -134,6 +134,37 @@ TEST(FirewireOmni, EncoderUnwrapsAcrossTheInt16WrapOverPackets) {
   EXPECT_NEAR(r.st.q_device_rad[0], 0.1 - 2 * kPi * 33800 / 15000, 1e-12);
 }
 
+TEST(FirewireOmni, WhatArrivedTellsLostFromSupersededAndLate) {
+  // The transport takes every packet that arrived and hands over the
+  // newest. Two arrive each tick here (2000 packets a second read at 1 kHz):
+  // a counter that steps by 2 loses nothing.
+  Rig r;
+  r.t->arrived_per_packet = 2;
+  for (std::uint32_t c : {2u, 4u, 6u, 8u}) {
+    r.t->push_packet(make_packet(c, {0, 0, 0}, {0, 0, 0}));
+  }
+  for (int k = 0; k < 4; ++k) ASSERT_EQ(r.read(), DeviceError::kOk);
+  FirewireOmniStats s = r.omni.stats();
+  EXPECT_EQ(s.packets, 4u);
+  EXPECT_EQ(s.lost_packets, 0u);
+  EXPECT_EQ(s.superseded_packets, 4u);
+  EXPECT_EQ(s.late_packets, 0u);
+  // a step of 5 with 2 arrived: 3 never came
+  r.t->push_packet(make_packet(13, {0, 0, 0}, {0, 0, 0}));
+  ASSERT_EQ(r.read(), DeviceError::kOk);
+  EXPECT_EQ(r.omni.stats().lost_packets, 3u);
+  // a tick that found two packets of which one had waited a period: late,
+  // and not lost
+  r.t->arrived_per_packet = 2;
+  r.t->late_per_packet = 1;
+  r.t->push_packet(make_packet(15, {0, 0, 0}, {0, 0, 0}));
+  ASSERT_EQ(r.read(), DeviceError::kOk);
+  s = r.omni.stats();
+  EXPECT_EQ(s.lost_packets, 3u);
+  EXPECT_EQ(s.late_packets, 1u);
+  EXPECT_EQ(s.superseded_packets, 6u);
+}
+
 TEST(FirewireOmni, TheInkwellSetsTheEncoderOffsets) {
   // Re-homing as the drivers do it: a docked packet makes t1..t3 read the
   // calibration's inkwell pose, whatever the offsets were; out of the
@@ -291,6 +322,12 @@ TEST(FirewireOmni, BusResetRecoversAndReseedsTheUnwrap) {
   EXPECT_EQ(r.read(), DeviceError::kNotConnected);
   EXPECT_EQ(r.st.present, 0u);
   EXPECT_EQ(r.t->recover_calls.load(), 1);
+  // zero words with the motors off went out before the recovery
+  ASSERT_GE(r.t->sent_at_recover.load(), 0);
+  const CommandPacket before = r.t->sent_command(
+      static_cast<std::size_t>(r.t->sent_at_recover.load()));
+  EXPECT_FALSE(before.motors_on());
+  EXPECT_EQ(before.motor[0], kMotorWordZero);
   ASSERT_EQ(r.read(), DeviceError::kOk);
   // re-seeded: 5, not unwrap_encoder(40000, 5) = 65541
   EXPECT_EQ(r.st.encoder_counts[0], 5);
