@@ -715,6 +715,7 @@ void Raw1394Transport::start() {
   if (const char* e = start_registers()) throw fail(e);
   ++record_.starts;
   started_ = true;
+  fresh_start_ = true;
 }
 
 void Raw1394Transport::stop() noexcept {
@@ -825,6 +826,18 @@ TransportStatus Raw1394Transport::receive(std::uint8_t* buf,
       resets_.fetch_add(1, std::memory_order_relaxed);
       return TransportStatus::kBusReset;
     }
+    if (batch_ >= kRxBufferPackets && fresh_start_) {
+      // The first receive after start() or recover() found the receive
+      // buffer full: the packets queued before the servo loop's first tick
+      // (setting up its thread can take tens of milliseconds), and the
+      // newest of them stale, as the ones after it did not fit. Discarded;
+      // the next packet is the loop's first.
+      stale_.fetch_add(batch_, std::memory_order_relaxed);
+      batch_ = 0;
+      rx_bad_ = false;
+      fresh_start_ = false;
+      continue;
+    }
     if (batch_ > 0) break;
     if (rx_bad_) {
       rx_bad_ = false;
@@ -844,11 +857,16 @@ TransportStatus Raw1394Transport::receive(std::uint8_t* buf,
   const std::uint32_t n = batch_;
   const std::size_t kept = n < batch_cycles_.size() ? n : batch_cycles_.size();
   const unsigned newest = batch_cycles_[kept - 1];
-  std::uint32_t late = static_cast<std::uint32_t>(n - kept);  // beyond the record
-  for (std::size_t i = 0; i + 1 < kept; ++i) {
-    const unsigned age = (newest + 8000u - batch_cycles_[i]) % 8000u;
-    if (age >= late_cycles_) ++late;
+  std::uint32_t late = 0;
+  if (!fresh_start_) {
+    // (the first batch after a start came before any receive: none late)
+    late = static_cast<std::uint32_t>(n - kept);  // beyond the record
+    for (std::size_t i = 0; i + 1 < kept; ++i) {
+      const unsigned age = (newest + 8000u - batch_cycles_[i]) % 8000u;
+      if (age >= late_cycles_) ++late;
+    }
   }
+  fresh_start_ = false;
   batch_ = 0;
   rx_bad_ = false;
   if (capacity < kStatePacketBytes) return TransportStatus::kIo;
@@ -919,6 +937,7 @@ TransportStatus Raw1394Transport::recover() noexcept {
   batch_ = 0;
   rx_bad_ = false;
   needs_recovery_ = false;
+  fresh_start_ = true;
   ++record_.starts;
   recoveries_.fetch_add(1, std::memory_order_relaxed);
   return TransportStatus::kOk;
@@ -936,6 +955,7 @@ TransportStats Raw1394Transport::stats() const noexcept {
   s.bus_resets = resets_.load(std::memory_order_relaxed);
   s.recoveries = recoveries_.load(std::memory_order_relaxed);
   s.eagain_retries = eagain_.load(std::memory_order_relaxed);
+  s.stale_at_start = stale_.load(std::memory_order_relaxed);
   return s;
 }
 

@@ -40,7 +40,10 @@
 // receive() iterates the receive handle until nothing is left, keeps every
 // packet's arrival cycle, hands over the newest and counts the others
 // (ReceiveInfo): 2000 packets a second read at 1 kHz is two packets a
-// call, not one packet a call and a backlog that never drains. A packet
+// call, not one packet a call and a backlog that never drains. The first
+// receive() after start() or recover() counts none late (there was no
+// earlier receive), and discards a full buffer (the newest packet in it is
+// stale: the ones after it were dropped) to wait for the next packet. A packet
 // that arrived late_after_s or more before the newest one is late: it was
 // there for an earlier receive(). send() services the transmit context:
 // every slot the device has consumed since is refilled with the newest
@@ -226,12 +229,13 @@ class Raw1394Transport final : public Transport {
   std::uint64_t tx_refills_ = 0;  // transmit slots filled
   bool reset_pending_ = false;    // a bus reset not yet returned
   bool needs_recovery_ = false;   // recover() failed: try again later
+  bool fresh_start_ = false;      // no packet handed over since (re)start
   int receives_since_recovery_ = 0;
 
   char error_[160] = {};  // the last failed step, for start()
   std::atomic<std::uint64_t> received_{0}, delivered_{0}, superseded_{0},
       late_{0}, sent_{0}, bad_{0}, timeouts_{0}, resets_{0}, recoveries_{0},
-      eagain_{0};
+      eagain_{0}, stale_{0};
 };
 
 }  // namespace vmh::hw::fw

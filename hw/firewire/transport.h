@@ -89,6 +89,9 @@ struct TransportStats {
   std::uint64_t bus_resets = 0;
   std::uint64_t recoveries = 0;   // successful recover() calls
   std::uint64_t eagain_retries = 0;  // register transactions retried
+  // packets queued before the first receive() after a start or recovery
+  // that filled the receive buffer, discarded as stale
+  std::uint64_t stale_at_start = 0;
 };
 
 // What one receive() took from the bus besides the packet it hands over.

@@ -406,6 +406,48 @@ TEST(FirewireBus, PacketsTheHostBufferCouldNotHoldAreLost) {
   EXPECT_EQ(s.late_packets, kRxBufferPackets - 1u);
 }
 
+TEST(FirewireBus, WhatQueuedBeforeTheFirstTickIsNeitherLateNorLost) {
+  // The stream starts in start(); the servo loop's first tick comes when
+  // its thread is set up. What queued meanwhile came before any receive:
+  // none of it is late.
+  bus().setup("omni=000b9900000a0a0a,rate=1000,speed=1000/0/0");
+  {
+    Raw1394Transport t(options());
+    FirewireOmni omni(&t, FirewireOmniOptions{});
+    t.start();
+    DeviceState st;
+    bus().advance_ms(10.0);
+    ASSERT_EQ(omni.read_state(&st), DeviceError::kOk);
+    EXPECT_EQ(omni.stats().superseded_packets, 9u);
+    EXPECT_EQ(omni.stats().late_packets, 0u);
+    EXPECT_EQ(st.encoder_counts[0], bus().info(kGuidA).encoder_counts[0]);
+    EXPECT_EQ(t.stats().stale_at_start, 0u);
+  }
+  // A first tick 100 ms late found the buffer full (64 of 100 kept): the
+  // newest it holds is 36 ms old and the ones after it were dropped. It is
+  // discarded, and the next packet is the loop's first: nothing stale
+  // handed over, nothing counted lost or late.
+  bus().setup("omni=000b9900000a0a0a,rate=1000,speed=1000/0/0");
+  Raw1394Transport t(options());
+  FirewireOmni omni(&t, FirewireOmniOptions{});
+  t.start();
+  DeviceState st;
+  bus().advance_ms(100.0);
+  EXPECT_EQ(omni.read_state(&st), DeviceError::kTimeout);  // nothing fresh
+  EXPECT_EQ(t.stats().stale_at_start, kRxBufferPackets);
+  EXPECT_EQ(bus().info(kGuidA).packets_dropped, 100u - kRxBufferPackets);
+  for (int k = 0; k < 10; ++k) {
+    bus().advance_ms(1.0);
+    ASSERT_EQ(omni.read_state(&st), DeviceError::kOk) << k;
+    EXPECT_EQ(st.encoder_counts[0], bus().info(kGuidA).encoder_counts[0]) << k;
+  }
+  const FirewireOmniStats s = omni.stats();
+  EXPECT_EQ(s.lost_packets, 0u);
+  EXPECT_EQ(s.late_packets, 0u);
+  EXPECT_EQ(s.superseded_packets, 0u);
+  EXPECT_EQ(s.packets, 10u);
+}
+
 TEST(FirewireBus, NothingArrivedIsATimeout) {
   bus().setup("omni=000b9900000a0a0a");
   Raw1394Transport t(options());
