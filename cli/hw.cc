@@ -83,6 +83,11 @@ void probe(const RecordOptions& o) {
     out["q_device_rad"] = nullptr;
   }
   out["session"] = runtime::session_json(r);
+  if (dev.meta) {
+    // the native FireWire driver's node, start sequence and packet counts
+    const Json m = dev.meta();
+    if (m.contains("firewire")) out["firewire"] = m.at("firewire");
+  }
   std::cout << dump_readable(out) << '\n';
   runtime::raise_if_cut_short(r, "hw probe");
   if (r.ticks < 2 || !s.has(kStateJoints)) {

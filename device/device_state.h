@@ -49,6 +49,9 @@ struct DeviceState {
   std::uint32_t buttons = 0;
   // the stylus is in the inkwell (the switch is closed)
   bool docked = false;
+  // the device set its encoder offsets again with this reading (a FireWire
+  // Omni re-homed in its inkwell): a step in t1..t3 is that, not a slip
+  bool rehomed = false;
   // a safety switch where the device has one (not on the Omni)
   bool safety_switch = false;
   // when the reading was taken, s, on a monotonic clock (the backend's; the

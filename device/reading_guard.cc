@@ -48,6 +48,14 @@ DeviceError ReadingGuard::read_state(DeviceState* state) noexcept {
     return err;
   }
   if (!params_.enabled) return DeviceError::kOk;
+  if (state->rehomed && q.allFinite()) {
+    // the offsets were set in the inkwell: the angle is right again, and
+    // the step to it is the calibration, not a slip
+    latched_ = false;
+    previous_ = q;
+    have_previous_ = true;
+    return DeviceError::kOk;
+  }
   if (latched_) {
     fault_ = GuardFault::kJump;
     state->present = 0;

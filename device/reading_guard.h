@@ -9,9 +9,11 @@
 //   an encoder (t1..t3) moving more in one servo period than a hand can
 //   move it (max_speed_rad_s x max_period_s)
 //                             -> kSensorFault, named "sensor_jump", latched
-//                                until reset(): after a count slip the
-//                                absolute angle is wrong for good, and the
-//                                real Omni must be re-homed in its inkwell
+//                                until reset() or a reading that says the
+//                                device re-homed (DeviceState::rehomed):
+//                                after a count slip the absolute angle is
+//                                wrong until the Omni is re-homed in its
+//                                inkwell, and a re-homed reading may step
 // A stuck encoder is not detected: a joint held still by the hand reads
 // exactly the same, so no check on the readings alone can tell the two
 // apart without false alarms (the study reports it as undetected).

@@ -38,6 +38,13 @@ void OmniCalibration::validate() const {
       throw std::invalid_argument("pot_gain_rad[" + std::to_string(i) +
                                   "] (t" + std::to_string(i + 4) + ") is 0");
     }
+    if (encoder_sign[k] != 1 && encoder_sign[k] != -1) {
+      throw std::invalid_argument("encoder_sign[" + std::to_string(i) + "] (t" +
+                                  std::to_string(i + 1) + ") is " +
+                                  std::to_string(encoder_sign[k]) +
+                                  ", not +1 or -1");
+    }
+    require_finite(inkwell_t123_rad[k], "inkwell_t123_rad", i);
   }
 }
 
@@ -49,7 +56,7 @@ EncoderCounts encoder_counts_from_angles(const Vec3& t123_device_rad,
   for (int i = 0; i < 3; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const double rel = t123_device_rad[i] - cal.encoder_offset_rad[k];
-    c[k] = to_code(kEncoderSign[k] * rel / encoder_step_rad(), "encoder count",
+    c[k] = to_code(cal.encoder_sign[k] * rel / encoder_step_rad(), "encoder count",
                    i + 1);
   }
   return c;
@@ -73,20 +80,35 @@ Joints angles_from_raw(const EncoderCounts& counts, const PotCodes& pots,
   for (int i = 0; i < 3; ++i) {
     const auto k = static_cast<std::size_t>(i);
     t[i] = cal.encoder_offset_rad[k] +
-           kEncoderSign[k] * encoder_step_rad() * counts[k];
+           cal.encoder_sign[k] * encoder_step_rad() * counts[k];
     t[i + 3] = cal.pot_gain_rad[k] * pots[k] + cal.pot_offset_rad[k];
   }
   return t;
 }
 
 std::array<double, 3> fit_encoder_offsets(const EncoderCounts& counts_docked,
-                                          const Vec3& inkwell_t123_rad) {
+                                          const Vec3& inkwell_t123_rad,
+                                          const std::array<int, 3>& sign) {
   std::array<double, 3> off{};
   for (int i = 0; i < 3; ++i) {
     const auto k = static_cast<std::size_t>(i);
     require_finite(inkwell_t123_rad[i], "inkwell_t123_rad", i);
-    off[k] = inkwell_t123_rad[i] -
-             kEncoderSign[k] * encoder_step_rad() * counts_docked[k];
+    if (sign[k] != 1 && sign[k] != -1) {
+      throw std::invalid_argument("encoder_sign[" + std::to_string(i) +
+                                  "] is " + std::to_string(sign[k]) +
+                                  ", not +1 or -1");
+    }
+    off[k] = inkwell_t123_rad[i] - sign[k] * encoder_step_rad() * counts_docked[k];
+  }
+  return off;
+}
+
+std::array<double, 3> docked_encoder_offsets(const EncoderCounts& counts_docked,
+                                             const OmniCalibration& cal) noexcept {
+  constexpr double kStep = kTwoPi / kEncoderCountsPerRev;
+  std::array<double, 3> off{};
+  for (std::size_t k = 0; k < 3; ++k) {
+    off[k] = cal.inkwell_t123_rad[k] - cal.encoder_sign[k] * kStep * counts_docked[k];
   }
   return off;
 }

@@ -50,21 +50,23 @@ const BackendInfo& BackendRegistry::resolve(const std::string& spec,
     const bool whole = spec == b.name;
     const bool prefix = spec.size() > b.name.size() &&
                         spec.compare(0, b.name.size(), b.name) == 0 &&
-                        spec[b.name.size()] == ':';
+                        (spec[b.name.size()] == ':' || spec[b.name.size()] == '?');
     if ((whole || prefix) &&
         (best == nullptr || b.name.size() > best->name.size())) {
       best = &b;
     }
   }
   if (best == nullptr) {
-    const std::string name = spec.substr(0, spec.find(':'));
+    const std::string name = spec.substr(0, spec.find_first_of(":?"));
     throw RequestError("--device: unknown backend '" + name + "' (expected " +
                        grammars() +
                        "; `vmhaptics hw list` shows what is available)");
   }
-  *argument = spec.size() > best->name.size()
+  // NAME:ARGUMENT gives ARGUMENT; NAME?OPTIONS gives "?OPTIONS"
+  *argument = spec.size() <= best->name.size() ? std::string()
+              : spec[best->name.size()] == ':'
                   ? spec.substr(best->name.size() + 1)
-                  : std::string();
+                  : spec.substr(best->name.size());
   return *best;
 }
 

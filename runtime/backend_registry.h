@@ -10,9 +10,10 @@
 // The command line calls hw::register_backends() and, where the build has
 // the testbed, sim::register_backends() before it parses.
 //
-// A spec is NAME[:ARGUMENT]; NAME is the longest registered name that the
-// spec is or begins with followed by ':' ("emulator:firewire:case2" is the
-// backend "emulator:firewire" with the argument "case2").
+// A spec is NAME[:ARGUMENT] or NAME?OPTIONS; NAME is the longest
+// registered name that the spec is or begins with followed by ':' or '?'
+// ("emulator:firewire:case2" is the backend "emulator:firewire" with the
+// argument "case2"; "firewire?no-20010" is "firewire" with "?no-20010").
 #ifndef VMHAPTICS_RUNTIME_BACKEND_REGISTRY_H_
 #define VMHAPTICS_RUNTIME_BACKEND_REGISTRY_H_
 

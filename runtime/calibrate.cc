@@ -125,12 +125,14 @@ Json calibrate(OpenedDevice* dev, const CalibrateOptions& o) {
     mean[i] = static_cast<std::int32_t>(
         std::lround(g.sum[i] / static_cast<double>(g.docked)));
   }
-  const Vec3 inkwell(hw::kInkwellDevice_rad[0], hw::kInkwellDevice_rad[1],
-                     hw::kInkwellDevice_rad[2]);
-  // start from the calibration the device decodes with (its pot gains'
-  // signs are kept below)
+  // start from the calibration the device decodes with: its encoder signs,
+  // its inkwell pose and its pot gains' signs are kept; the offsets are
+  // fitted
   hw::OmniCalibration cal = dev->raw->calibration();
-  cal.encoder_offset_rad = hw::fit_encoder_offsets(mean, inkwell);
+  const Vec3 inkwell(cal.inkwell_t123_rad[0], cal.inkwell_t123_rad[1],
+                     cal.inkwell_t123_rad[2]);
+  cal.encoder_offset_rad =
+      hw::fit_encoder_offsets(mean, inkwell, cal.encoder_sign);
 
   // 2. gimbal: the extreme codes of the sweep phase are the range's ends
   const auto ranges = gimbal_ranges();
@@ -178,12 +180,15 @@ Json calibrate(OpenedDevice* dev, const CalibrateOptions& o) {
     spread.push_back(static_cast<long>(g.dock_hi[i]) - g.dock_lo[i]);
   }
   stored.details = Json{{"inkwell_pose_rad", {inkwell[0], inkwell[1], inkwell[2]}},
+                        {"encoder_sign", cal.encoder_sign},
                         {"docked_ticks", g.docked},
                         {"docked_counts", mean},
                         {"docked_spread_counts", spread},
                         {"gimbal", pots}};
   Json out{{"device", identity_json(dev->backend->identity())},
            {"encoder_offset_rad", cal.encoder_offset_rad},
+           {"encoder_sign", cal.encoder_sign},
+           {"inkwell_t123_rad", cal.inkwell_t123_rad},
            {"pot_gain_rad", cal.pot_gain_rad},
            {"pot_offset_rad", cal.pot_offset_rad},
            {"details", stored.details},

@@ -2,7 +2,8 @@
 // reports raw sensor values (the FireWire Omni, the emulator directly or
 // behind the packets), stored per serial number (runtime/calibration_store.h):
 //   1. the stylus in the inkwell: the encoder offsets that make the docked
-//      counts read as the inkwell pose (hw::fit_encoder_offsets);
+//      counts, counted in the calibration's encoder signs, read as its
+//      inkwell pose (hw::fit_encoder_offsets);
 //   2. each gimbal joint turned to both ends of its range: a two-point fit
 //      of its potentiometer, the extreme codes taken as the range's ends
 //      (hw::fit_pot_two_point).

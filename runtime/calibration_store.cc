@@ -51,6 +51,32 @@ std::array<double, 3> triple(const Json& j, const char* key,
   return out;
 }
 
+// an optional array of three +1 / -1 (whole numbers in JSON)
+std::array<int, 3> signs(const Json& j, const char* key, const std::string& path,
+                         const std::array<int, 3>& fallback) {
+  if (!j.contains(key)) return fallback;
+  const Json& v = j[key];
+  if (!v.is_array() || v.size() != 3) {
+    throw CalibrationError(path + ": '" + key +
+                           "' must be an array of 3 signs (+1 or -1), got " +
+                           v.type_name());
+  }
+  std::array<int, 3> out{};
+  for (int i = 0; i < 3; ++i) {
+    if (!v[i].is_number_integer()) {
+      throw CalibrationError(path + ": " + joint_name(key, i) +
+                             " must be +1 or -1, got " + v[i].dump());
+    }
+    const auto x = v[i].get<long long>();
+    if (x != 1 && x != -1) {
+      throw CalibrationError(path + ": " + joint_name(key, i) + " = " +
+                             std::to_string(x) + " is not +1 or -1");
+    }
+    out[static_cast<std::size_t>(i)] = static_cast<int>(x);
+  }
+  return out;
+}
+
 std::string text_field(const Json& j, const char* key,
                        const std::string& path, const std::string& fallback) {
   if (!j.contains(key)) return fallback;
@@ -88,6 +114,18 @@ void check_calibration(const hw::OmniCalibration& c, const std::string& where) {
                              " = " + num(o) +
                              " rad puts the pot's codes at angles beyond "
                              "+-4 pi");
+    }
+    const int sg = c.encoder_sign[k];
+    if (sg != 1 && sg != -1) {
+      throw CalibrationError(where + ": " + joint_name("encoder_sign", i) +
+                             " = " + std::to_string(sg) +
+                             " is not +1 or -1");
+    }
+    const double ink = c.inkwell_t123_rad[k];
+    if (!std::isfinite(ink) || std::abs(ink) > kMaxEncoderOffsetRad) {
+      throw CalibrationError(where + ": " + joint_name("inkwell_t123_rad", i) +
+                             " = " + num(ink) +
+                             " rad is not a finite angle within +-pi");
     }
   }
 }
@@ -145,6 +183,14 @@ std::optional<StoredCalibration> load_calibration(const std::string& serial) {
   c.calibration.encoder_offset_rad = triple(j, "encoder_offset_rad", path);
   c.calibration.pot_gain_rad = triple(j, "pot_gain_rad", path);
   c.calibration.pot_offset_rad = triple(j, "pot_offset_rad", path);
+  // written since the signs became data; a file from before has the
+  // nominal ones (its offsets were fitted with the signs of that time:
+  // docs/hardware.md, "Calibration")
+  c.calibration.encoder_sign =
+      signs(j, "encoder_sign", path, hw::kNominalEncoderSign);
+  if (j.contains("inkwell_t123_rad")) {
+    c.calibration.inkwell_t123_rad = triple(j, "inkwell_t123_rad", path);
+  }
   check_calibration(c.calibration, path);
   c.serial = text_field(j, "serial", path, serial);
   c.backend = text_field(j, "backend", path, "");
@@ -160,6 +206,8 @@ std::string save_calibration(const StoredCalibration& c) {
          {"backend", c.backend},
          {"date_utc", c.date_utc},
          {"encoder_offset_rad", c.calibration.encoder_offset_rad},
+         {"encoder_sign", c.calibration.encoder_sign},
+         {"inkwell_t123_rad", c.calibration.inkwell_t123_rad},
          {"pot_gain_rad", c.calibration.pot_gain_rad},
          {"pot_offset_rad", c.calibration.pot_offset_rad},
          {"details", c.details}};

@@ -37,6 +37,10 @@ struct CalibrationError : std::runtime_error {
 // The plausible ranges (docs/hardware.md, "Calibration"):
 //   encoder_offset_rad  |x| <= pi: an offset is where count zero is, and
 //                       the counts are zeroed near the inkwell pose
+//   encoder_sign        +1 or -1 (a file without it: the nominal signs,
+//                       hw::kNominalEncoderSign)
+//   inkwell_t123_rad    |x| <= pi (a file without it: the estimate
+//                       hw::kInkwellDevice_rad)
 //   pot_gain_rad        1e-4 <= |x| <= 1e-2 rad per code: a 10- to 12-bit
 //                       pot across a gimbal joint's 2.3 to 5.2 rad range is
 //                       5.5e-4 to 5.1e-3 rad per code; 1e-2 is a sweep that

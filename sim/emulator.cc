@@ -77,12 +77,16 @@ void sleep_until_ns(std::int64_t ns) noexcept {
   }
 }
 
-// The hidden factory calibration of a device: encoder offsets near the
-// drivers' inkwell offsets (-0.23 rad for t1, +0.37 rad for t2,
-// docs/sources.md §9.2), whole counts, moved per serial; pots reading the
-// sensor model's 2^bits levels (its span: the joint's range) with a
-// per-serial count of codes below the range's lower end. Computed exactly
-// as SensorModel computes its levels, so that decoding gives its values.
+// The hidden factory calibration of a device: the public drivers' encoder
+// signs and pot directions (hw::kNominalEncoderSign; t5's pot turns the
+// other way, hw::kNominalPotGainPerRatio_rad), so that the host's decoding
+// meets the signs a device has; encoder offsets of whole counts, moved per
+// serial about two arbitrary bases (-0.23 and +0.37 rad for t1 and t2,
+// which once stood for the drivers' inkwell offsets; kept so that traces
+// stay comparable); pots reading the sensor model's 2^bits levels (its
+// span: the joint's range) with a per-serial count of codes beyond the
+// range's end at code zero. Computed exactly as SensorModel computes its
+// levels, so that decoding gives its values.
 hw::OmniCalibration factory_for(const std::string& serial,
                                 const OmniParams& omni) {
   const std::uint64_t h = serial_hash(serial);
@@ -90,6 +94,7 @@ hw::OmniCalibration factory_for(const std::string& serial,
   const double base_counts[3] = {std::round(-0.23 / step),
                                  std::round(0.37 / step), 0.0};
   hw::OmniCalibration cal;
+  cal.encoder_sign = hw::kNominalEncoderSign;
   Joints a, b;
   device_joint_ranges(omni, &a, &b);
   const double levels = std::ldexp(1.0, omni.gimbal_pot_bits);
@@ -100,8 +105,13 @@ hw::OmniCalibration factory_for(const std::string& serial,
     const int j = i + 3;
     const double pot_step = std::abs(b[j] - a[j]) / (levels - 1.0);
     const double below = static_cast<double>(8 + (h >> (8 * i + 32)) % 33);
-    cal.pot_gain_rad[k] = pot_step;
-    cal.pot_offset_rad[k] = std::min(a[j], b[j]) - below * pot_step;
+    if (hw::kNominalPotGainPerRatio_rad[i] >= 0.0) {
+      cal.pot_gain_rad[k] = pot_step;
+      cal.pot_offset_rad[k] = std::min(a[j], b[j]) - below * pot_step;
+    } else {
+      cal.pot_gain_rad[k] = -pot_step;
+      cal.pot_offset_rad[k] = std::max(a[j], b[j]) + below * pot_step;
+    }
   }
   return cal;
 }

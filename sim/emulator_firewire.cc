@@ -241,8 +241,10 @@ void EmulatorFirewireTransport::apply_due_faults() noexcept {
 TransportStatus EmulatorFirewireTransport::receive(std::uint8_t* buf,
                                                    std::size_t capacity,
                                                    std::size_t* size,
-                                                   double /*timeout_s*/) noexcept {
+                                                   double /*timeout_s*/,
+                                                   hw::fw::ReceiveInfo* info) noexcept {
   *size = 0;
+  if (info != nullptr) *info = hw::fw::ReceiveInfo{};
   apply_due_faults();
   if (reset_pending_.load(std::memory_order_acquire)) {
     publish_stats();
@@ -305,6 +307,8 @@ TransportStatus EmulatorFirewireTransport::receive(std::uint8_t* buf,
   }
   std::memcpy(buf, bytes, hw::fw::kStatePacketBytes);
   ++s_.received;
+  ++s_.delivered;
+  if (info != nullptr) info->packets = 1;
   publish_stats();
   return TransportStatus::kOk;
 }

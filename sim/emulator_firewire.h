@@ -19,10 +19,12 @@
 //   packet_number  the counter's low 8 bits
 //   time           when the reading was taken, microseconds since start()
 //                  (a late reading carries its old time), wrapping at 2^32
-// It returns at once: the newest packet, or kTimeout when the emulator has
-// none fresh (its read_state's staleness rule: older than 3 periods), or a
-// fault below. It never waits for timeout_s, so that the servo thread keeps
-// its period as on the plain emulator.
+// It returns at once: the newest packet (ReceiveInfo: one packet, none
+// late: the emulator publishes once a period and the call takes it), or
+// kTimeout when the emulator has none fresh (its read_state's staleness
+// rule: older than 3 periods), or a fault below. It never waits for
+// timeout_s, so that the servo thread keeps its period as on the plain
+// emulator.
 //
 // send(): decode_command(); motors off -> zero torque, else per motor
 //   tau = factory_motor_sign * u * factory_full_scale_Nm,
@@ -119,8 +121,8 @@ class EmulatorFirewireTransport final : public hw::fw::Transport {
   void start() override;
   void stop() noexcept override;
   hw::fw::TransportStatus receive(std::uint8_t* buf, std::size_t capacity,
-                                  std::size_t* size,
-                                  double timeout_s) noexcept override;
+                                  std::size_t* size, double timeout_s,
+                                  hw::fw::ReceiveInfo* info) noexcept override;
   hw::fw::TransportStatus send(const std::uint8_t* data,
                                std::size_t size) noexcept override;
   hw::fw::TransportStatus recover() noexcept override;

@@ -64,6 +64,8 @@ FirewireOmni::FirewireOmni(Transport* transport,
   }
   options_.validate();
   cal_.write(options_.calibration);
+  cal_local_ = options_.calibration;
+  in_use_.write(options_.calibration);
   calibrated_.store(options_.calibrated, std::memory_order_release);
   stats_.write(s_);
   last_.write(StatePacket{});
@@ -72,7 +74,18 @@ FirewireOmni::FirewireOmni(Transport* transport,
 void FirewireOmni::set_calibration(const OmniCalibration& cal) {
   cal.validate();
   cal_.write(cal);
+  cal_gen_.fetch_add(1, std::memory_order_acq_rel);
   calibrated_.store(true, std::memory_order_release);
+}
+
+OmniCalibration FirewireOmni::calibration() const noexcept {
+  // the servo loop's copy once it has taken the latest set_calibration()
+  const std::uint64_t set = cal_gen_.load(std::memory_order_acquire);
+  if (in_use_gen_.load(std::memory_order_acquire) == set) {
+    const OmniCalibration c = in_use_.read();
+    if (in_use_gen_.load(std::memory_order_acquire) == set) return c;
+  }
+  return cal_.read();
 }
 
 DeviceError FirewireOmni::read_joints(Joints* q_device_rad) noexcept {
@@ -82,8 +95,9 @@ DeviceError FirewireOmni::read_joints(Joints* q_device_rad) noexcept {
 DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
   state->present = 0;
   std::size_t size = 0;
+  ReceiveInfo info;
   const TransportStatus ts = transport_->receive(
-      rx_.data(), rx_.size(), &size, options_.receive_timeout_s);
+      rx_.data(), rx_.size(), &size, options_.receive_timeout_s, &info);
   switch (ts) {
     case TransportStatus::kOk:
       break;
@@ -92,10 +106,13 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
       publish();
       return DeviceError::kTimeout;
     case TransportStatus::kBusReset:
-      // The node id and the iso channels may have changed: find the node
-      // again and restart it. This tick has no reading either way, and the
-      // counts after the reset need not continue the ones before it.
+      // The node id and the iso channels may have changed: zero words with
+      // the motors off for whatever the device takes meanwhile, then find
+      // the node again and restart it. This tick has no reading either
+      // way, and the counts after the reset need not continue the ones
+      // before it.
       ++s_.bus_resets;
+      send_zero();
       if (transport_->recover() != TransportStatus::kOk) {
         ++s_.recoveries_failed;
       }
@@ -120,11 +137,15 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
     return DeviceError::kIo;
   }
   ++s_.packets;
+  const std::uint32_t arrived = info.packets > 0 ? info.packets : 1u;
+  s_.superseded_packets += arrived - 1u;
+  s_.late_packets += info.late;
   if (have_counter_) {
-    // a gap of k means k packets were never seen; a counter that went
-    // backwards (a restarted device) is not a loss
-    const std::uint32_t gap = p.counter - s_.last_counter - 1u;
-    if (gap < 0x80000000u) s_.lost_packets += gap;
+    // The counter moves one a packet. A step of k with `arrived` packets
+    // taken means k - arrived were sent and never arrived; a counter that
+    // went backwards (a restarted device) is not a loss.
+    const std::uint32_t step = p.counter - s_.last_counter;
+    if (step < 0x80000000u && step > arrived) s_.lost_packets += step - arrived;
   }
   have_counter_ = true;
   s_.last_counter = p.counter;
@@ -135,6 +156,31 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
   }
   have_counts_ = true;
   last_.write(p);
+
+  // the calibration in use: a newly set one, the inkwell's offsets
+  bool changed = false;
+  const std::uint64_t gen = cal_gen_.load(std::memory_order_acquire);
+  if (gen != cal_local_gen_) {
+    cal_local_ = cal_.read();
+    cal_local_gen_ = gen;
+    changed = true;
+  }
+  const bool docked = p.docked();
+  bool rehomed = false;
+  if (options_.rehome_in_inkwell && docked) {
+    const std::array<double, 3> off = docked_encoder_offsets(counts_, cal_local_);
+    if (off != cal_local_.encoder_offset_rad) {
+      cal_local_.encoder_offset_rad = off;
+      changed = true;
+      rehomed = true;
+    }
+    if (!was_docked_) ++s_.rehomes;
+  }
+  was_docked_ = docked;
+  if (changed) {
+    in_use_.write(cal_local_);
+    in_use_gen_.store(cal_local_gen_, std::memory_order_release);
+  }
   publish();
 
   PotCodes pots{};
@@ -143,10 +189,11 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
     if (pots[i] < 0) return DeviceError::kSensorFault;  // an open pot
   }
 
-  state->q_device_rad = angles_from_raw(counts_, pots, cal_.read());
+  state->q_device_rad = angles_from_raw(counts_, pots, cal_local_);
   state->buttons = (p.button1_pressed() ? kButton1 : 0u) |
                    (p.button2_pressed() ? kButton2 : 0u);
-  state->docked = p.docked();
+  state->docked = docked;
+  state->rehomed = rehomed;
   state->timestamp_s = monotonic_now_s();
   state->encoder_counts = counts_;
   state->gimbal_pots = pots;

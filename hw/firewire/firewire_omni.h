@@ -8,16 +8,29 @@
 //                             the device convention, lost-packet and
 //                             bus-reset handling; the servo thread
 //
-// read_state(): one receive() (at most options.receive_timeout_s), decoded
-// to encoder counts (unwrapped from int16 to int32 across packets), pot
-// codes (pot_code of the a/b words), buttons, the inkwell switch and a
-// CLOCK_MONOTONIC timestamp; then angles_from_raw() with the calibration.
-// Fills kStateJoints | kStateButtons | kStateInkwell | kStateTimestamp |
-// kStateEncoders | kStatePots. Maps TransportStatus to DeviceError:
-// kTimeout -> kTimeout, kBusReset -> recover() then kNotConnected for this
-// tick (the encoder unwrap is re-seeded from the next packet),
-// kDisconnected -> kNotConnected, kIo / kBadPacket -> kIo. A pot that reads
-// open (a + b = 0) is kSensorFault.
+// read_state(): one receive() (at most options.receive_timeout_s), which
+// takes every packet that arrived since the last tick and hands over the
+// newest; decoded to encoder counts (unwrapped from int16 to int32 across
+// packets), pot codes (pot_code of the a/b words), buttons, the inkwell
+// switch and a CLOCK_MONOTONIC timestamp; then angles_from_raw() with the
+// calibration. Fills kStateJoints | kStateButtons | kStateInkwell |
+// kStateTimestamp | kStateEncoders | kStatePots. Counts, from the device's
+// packet counter and what the transport says arrived: lost packets (the
+// counter moved further than the packets that arrived: the bus lost them),
+// superseded ones (arrived, a newer one was used) and late ones (arrived a
+// tick late). Maps TransportStatus to DeviceError: kTimeout -> kTimeout,
+// kBusReset -> zero words with the motors off, recover(), kNotConnected
+// for this tick (the encoder unwrap is re-seeded from the next packet),
+// kDisconnected -> kNotConnected, kIo / kBadPacket -> kIo. A pot that
+// reads open (a + b = 0) is kSensorFault.
+//
+// Re-homing (options.rehome_in_inkwell, on by default, as the public
+// drivers do it): every packet that says the stylus is in the inkwell sets
+// the encoder offsets so that t1..t3 read the calibration's
+// inkwell_t123_rad. Encoders count from wherever they were when the
+// device powered up (whether they reset then is not known), so a stored
+// offset is right only until the device is restarted; the inkwell puts it
+// right again.
 //
 // write_motor_torques(): per motor u = motor_sign * tau / full_scale_Nm,
 // saturated to [-1, 1] by the codec; a non-finite torque sends zero words
@@ -26,7 +39,8 @@
 //
 // NOT VERIFIED ON A DEVICE (docs/hardware.md): the packet layout, the
 // motor word's sign and full scale (kMotorFullScaleEstimate_Nm), the
-// direction each encoder counts (hw::kEncoderSign).
+// direction each encoder counts and each pot's line (nominal_calibration),
+// the inkwell pose.
 #ifndef VMHAPTICS_HW_FIREWIRE_FIREWIRE_OMNI_H_
 #define VMHAPTICS_HW_FIREWIRE_FIREWIRE_OMNI_H_
 
@@ -59,16 +73,20 @@ namespace vmh::hw::fw {
 inline constexpr double kMotorFullScaleEstimate_Nm = 3.3 * 0.13335;
 
 // A calibration to start from before `hw calibrate` has fitted the unit's
-// own: encoder offsets zero (angles relative to where the counters started)
-// and every gimbal pot on §9.2's example line theta = 5.48 r - 2.74 rad with
-// r = code / kPotCodeMax. The pot constants differ per unit (§9.2): angles
-// read through this are rough; calibration_state() says kNeedsUpdate.
+// own: the drivers' encoder signs (hw::kNominalEncoderSign) and gimbal
+// lines (hw::kNominalPotGainPerRatio_rad, hw::kNominalPotOffset_rad, with
+// r = code / kPotCodeMax), the estimated inkwell pose,
+// encoder offsets zero until the stylus is first docked (re-homing), or
+// angles relative to where the counters started without it. The pot
+// constants differ per unit (§9.2): angles read through this are rough;
+// calibration_state() says kNeedsUpdate.
 inline OmniCalibration nominal_calibration() {
   OmniCalibration c;
+  c.encoder_sign = kNominalEncoderSign;
   for (std::size_t i = 0; i < 3; ++i) {
     c.encoder_offset_rad[i] = 0.0;
-    c.pot_gain_rad[i] = 5.48 / kPotCodeMax;
-    c.pot_offset_rad[i] = -2.74;
+    c.pot_gain_rad[i] = kNominalPotGainPerRatio_rad[i] / kPotCodeMax;
+    c.pot_offset_rad[i] = kNominalPotOffset_rad[i];
   }
   return c;
 }
@@ -86,14 +104,20 @@ struct FirewireOmniOptions {
   // +1 or -1: the sign of u for a positive device-convention torque
   std::array<int, 3> motor_sign{+1, +1, +1};
   double receive_timeout_s = 2e-3;  // per read_state (> 0)
+  // set the encoder offsets from every docked packet (see above)
+  bool rehome_in_inkwell = true;
   // Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
 
 // What the device layer counted (safe to read from any thread).
 struct FirewireOmniStats {
-  std::uint64_t packets = 0;        // state packets decoded
-  std::uint64_t lost_packets = 0;   // counter gaps between decoded packets
+  std::uint64_t packets = 0;        // state packets decoded (one a tick)
+  std::uint64_t lost_packets = 0;   // sent by the device, never arrived
+  std::uint64_t superseded_packets = 0;  // arrived, a newer one was used
+  std::uint64_t late_packets = 0;   // arrived a tick late (ReceiveInfo)
+  std::uint64_t rehomes = 0;        // times the stylus went into the inkwell
+                                    // and the encoder offsets were set
   std::uint64_t bad_packets = 0;    // refused by the codec or the transport
   std::uint64_t timeouts = 0;
   std::uint64_t bus_resets = 0;
@@ -116,13 +140,16 @@ class FirewireOmni final : public HapticDevice {
   // zero words, motors off (stop, faults)
   DeviceError send_zero() noexcept;
 
-  // from one thread at a time, any thread (validated; throws
-  // std::invalid_argument); marks the device calibrated
+  // From one thread at a time, not the servo thread (validated; throws
+  // std::invalid_argument); marks the device calibrated. The servo loop
+  // takes it at its next tick.
   void set_calibration(const OmniCalibration& cal);
   bool calibrated() const noexcept {
     return calibrated_.load(std::memory_order_acquire);
   }
-  OmniCalibration calibration() const noexcept { return cal_.read(); }
+  // the calibration readings are decoded with: the one set last, with the
+  // encoder offsets the inkwell has set since (any thread)
+  OmniCalibration calibration() const noexcept;
   FirewireOmniStats stats() const noexcept { return stats_.read(); }
   // the last decoded packet (for `hw probe`)
   StatePacket last_packet() const noexcept { return last_.read(); }
@@ -130,7 +157,13 @@ class FirewireOmni final : public HapticDevice {
  private:
   Transport* transport_;
   FirewireOmniOptions options_;
+  // set_calibration()'s (its writer) and the servo loop's own copy with the
+  // re-homed offsets (the servo thread is its only writer); the generation
+  // says which set_calibration() a copy comes from
   Seqlock<OmniCalibration> cal_;
+  std::atomic<std::uint64_t> cal_gen_{0};
+  Seqlock<OmniCalibration> in_use_;
+  std::atomic<std::uint64_t> in_use_gen_{0};
   Seqlock<FirewireOmniStats> stats_;
   Seqlock<StatePacket> last_;
   std::atomic<bool> calibrated_{false};
@@ -138,9 +171,12 @@ class FirewireOmni final : public HapticDevice {
   std::array<std::uint8_t, 64> rx_{};  // one received packet (> 44 bytes, so
                                        // a long one arrives whole)
   FirewireOmniStats s_;
+  OmniCalibration cal_local_;
+  std::uint64_t cal_local_gen_ = 0;
   bool have_counts_ = false;
   std::array<std::int32_t, 3> counts_{};
   bool have_counter_ = false;
+  bool was_docked_ = false;
   bool motors_on_ = false;
 
   DeviceError send_command(const CommandPacket& c) noexcept;

@@ -76,6 +76,62 @@ TEST(ReadingGuard, AJumpLatchesUntilReset) {
   EXPECT_EQ(guard.read_joints(&q), DeviceError::kOk);
 }
 
+// a device whose readings say when it set its encoder offsets again (a
+// FireWire Omni re-homed in its inkwell)
+class RehomingDevice final : public HapticDevice {
+ public:
+  Joints q = Joints::Zero();
+  bool rehomed = false;
+  DeviceError read_joints(Joints* out) noexcept override {
+    *out = q;
+    return DeviceError::kOk;
+  }
+  DeviceError read_state(DeviceState* s) noexcept override {
+    s->q_device_rad = q;
+    s->rehomed = rehomed;
+    s->present = kStateJoints;
+    return DeviceError::kOk;
+  }
+  DeviceError write_motor_torques(const Vec3&) noexcept override {
+    return DeviceError::kOk;
+  }
+};
+
+TEST(ReadingGuard, AReHomedReadingMayStepAndEndsTheLatch) {
+  RehomingDevice dev;
+  ReadingGuard guard(&dev, guard_params());
+  DeviceState s;
+  dev.q = ramp(0.0);
+  ASSERT_EQ(guard.read_state(&s), DeviceError::kOk);
+  // a slip: latched
+  dev.q[0] += 1000.0 * kCount;
+  EXPECT_EQ(guard.read_state(&s), DeviceError::kSensorFault);
+  EXPECT_TRUE(guard.latched());
+  EXPECT_EQ(guard.read_state(&s), DeviceError::kSensorFault);
+  // docked: the device sets its offsets, the reading steps to the inkwell
+  // pose; the angle is right again
+  dev.q = ramp(0.0);
+  dev.q[2] -= 0.6;
+  dev.rehomed = true;
+  EXPECT_EQ(guard.read_state(&s), DeviceError::kOk);
+  EXPECT_FALSE(guard.latched());
+  EXPECT_EQ(s.q_device_rad, dev.q);
+  // and the next readings are compared with it again: a slip still latches
+  dev.rehomed = false;
+  EXPECT_EQ(guard.read_state(&s), DeviceError::kOk);
+  dev.q[1] += 1000.0 * kCount;
+  EXPECT_EQ(guard.read_state(&s), DeviceError::kSensorFault);
+  EXPECT_TRUE(guard.latched());
+  // a re-homed reading that steps with no latch is passed too
+  guard.reset();
+  dev.q = ramp(0.0);
+  ASSERT_EQ(guard.read_state(&s), DeviceError::kOk);
+  dev.q[0] += 0.5;
+  dev.rehomed = true;
+  EXPECT_EQ(guard.read_state(&s), DeviceError::kOk);
+  EXPECT_EQ(guard.last_fault(), GuardFault::kNone);
+}
+
 TEST(ReadingGuard, ThresholdIsTheSpeedTimesTheLongestPeriod) {
   ScriptedDevice dev;
   GuardParams p = guard_params();

@@ -12,8 +12,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -56,17 +58,29 @@ class CountingLoop : public ServoLoop {
   explicit CountingLoop(long limit = 0) : limit_(limit) {}
   bool tick(double now_s) noexcept override {
     if (now_s <= last_s_) decreasing_.store(true);
+    if (last_s_ < 0.0) first_s_.store(now_s);
+    if (last_s_ >= 0.0 && now_s - last_s_ > max_gap_s_.load()) {
+      max_gap_s_.store(now_s - last_s_);
+    }
     last_s_ = now_s;
+    last_seen_s_.store(now_s);
     const long n = calls_.load() + 1;
     calls_.store(n);
     return limit_ == 0 || n < limit_;
   }
   long calls() const { return calls_.load(); }
   bool time_went_back() const { return decreasing_.load(); }
+  // the longest time without a tick, s (monotonic_now_s), from `since_s`
+  // to the first tick, between ticks, and from the last one to `until_s`
+  double longest_gap_s(double since_s, double until_s) const {
+    return std::max({first_s_.load() - since_s, max_gap_s_.load(),
+                     until_s - last_seen_s_.load()});
+  }
 
  private:
   long limit_;
   double last_s_ = -1.0;
+  std::atomic<double> first_s_{0.0}, max_gap_s_{0.0}, last_seen_s_{0.0};
   std::atomic<long> calls_{0};
   std::atomic<bool> decreasing_{false};
 };
@@ -346,19 +360,36 @@ TEST(ServoThread, StallHandlerQuietWhileTicking) {
   std::atomic<int> stalls{0};
   ServoThread t(&loop, normal(2e-3));
   t.set_stall_handler(count_stall, &stalls, 100);
+  const double start_s = monotonic_now_s();
   t.start();
   ASSERT_TRUE(wait_for([&] { return loop.calls() >= 300; }));
   t.stop();
-  EXPECT_EQ(stalls.load(), 0);
+  // The monitor fires only after no tick for a whole window: a host that
+  // held the thread up that long makes that right, so it is judged only
+  // when every gap was well under the window (named otherwise).
+  const double gap_s = loop.longest_gap_s(start_s, monotonic_now_s());
+  if (gap_s < 0.8 * 100 * 2e-3) {
+    EXPECT_EQ(stalls.load(), 0) << "longest gap " << gap_s << " s";
+  } else {
+    std::printf("the host held the servo thread up for %.3f s: not judged\n", gap_s);
+  }
+  stalls = 0;
   // a loop that ended by itself is not a stall either
+  // (a window of 50 periods, and three of them waited after the end)
   CountingLoop ends(3);
   ServoThread t2(&ends, normal(1e-3));
-  t2.set_stall_handler(count_stall, &stalls, 4);
+  t2.set_stall_handler(count_stall, &stalls, 50);
+  const double start2_s = monotonic_now_s();
   t2.start();
   ASSERT_TRUE(wait_for([&] { return !t2.running(); }));
-  sleep_s(0.05);
+  sleep_s(0.15);
   t2.stop();
-  EXPECT_EQ(stalls.load(), 0);
+  const double gap2_s = ends.longest_gap_s(start2_s, 0.0);  // up to the end
+  if (gap2_s < 0.8 * 50 * 1e-3) {
+    EXPECT_EQ(stalls.load(), 0) << "longest gap " << gap2_s << " s";
+  } else {
+    std::printf("the host held the servo thread up for %.3f s: not judged\n", gap2_s);
+  }
 }
 
 TEST(ServoThread, StallHandlerCannotChangeWhileRunning) {

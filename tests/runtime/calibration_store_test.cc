@@ -63,7 +63,76 @@ TEST_F(StoreTest, AStoredFitReadsBackAsWritten) {
   EXPECT_EQ(back->calibration.pot_gain_rad, c.calibration.pot_gain_rad);
   EXPECT_EQ(back->calibration.encoder_offset_rad, c.calibration.encoder_offset_rad);
   EXPECT_EQ(back->backend, "emulator");
+  EXPECT_EQ(back->calibration.encoder_sign, c.calibration.encoder_sign);
+  EXPECT_EQ(back->calibration.inkwell_t123_rad, c.calibration.inkwell_t123_rad);
   EXPECT_FALSE(load_calibration("nobody").has_value());
+  // signs and the inkwell pose other than the nominal ones come back too
+  c.calibration.encoder_sign = {1, -1, -1};
+  c.calibration.inkwell_t123_rad = {0.01, 0.23, -0.37};
+  c.serial = "EMU-0002";
+  save_calibration(c);
+  const auto other = load_calibration("EMU-0002");
+  ASSERT_TRUE(other.has_value());
+  EXPECT_EQ(other->calibration.encoder_sign, (std::array<int, 3>{1, -1, -1}));
+  EXPECT_EQ(other->calibration.inkwell_t123_rad,
+            (std::array<double, 3>{0.01, 0.23, -0.37}));
+}
+
+TEST_F(StoreTest, AFileFromBeforeTheSignsHasTheNominalOnes) {
+  // as `hw calibrate` wrote them before the signs and the inkwell pose
+  // were stored
+  write("old", "{\"serial\": \"old\", \"encoder_offset_rad\": [-0.2, 0.3, 0.1], "
+               "\"pot_gain_rad\": [0.0025, -0.0025, 0.0023], "
+               "\"pot_offset_rad\": [-2.7, 2.6, -2.4]}");
+  const auto c = load_calibration("old");
+  ASSERT_TRUE(c.has_value()) << refusal("old");
+  EXPECT_EQ(c->calibration.encoder_sign, hw::kNominalEncoderSign);
+  EXPECT_EQ(c->calibration.encoder_sign, (std::array<int, 3>{-1, -1, 1}));
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(c->calibration.inkwell_t123_rad[i], hw::kInkwellDevice_rad[i]) << i;
+  }
+  EXPECT_EQ(c->calibration.encoder_offset_rad, (std::array<double, 3>{-0.2, 0.3, 0.1}));
+}
+
+TEST_F(StoreTest, BadSignsAndInkwellPosesAreRefusedNamingTheJoint) {
+  const std::string rest =
+      "\"encoder_offset_rad\": [0, 0, 0], \"pot_gain_rad\": [0.001, 0.001, "
+      "0.001], \"pot_offset_rad\": [0, 0, 0]";
+  write("s0", "{" + rest + ", \"encoder_sign\": [-1, 0, 1]}");
+  EXPECT_NE(refusal("s0").find("encoder_sign[1] (t2) = 0 is not +1 or -1"),
+            std::string::npos) << refusal("s0");
+  write("s2", "{" + rest + ", \"encoder_sign\": [-1, 1, 2]}");
+  EXPECT_NE(refusal("s2").find("encoder_sign[2] (t3) = 2"), std::string::npos)
+      << refusal("s2");
+  write("sf", "{" + rest + ", \"encoder_sign\": [1.0, 1, 1]}");
+  EXPECT_NE(refusal("sf").find("encoder_sign[0] (t1) must be +1 or -1"),
+            std::string::npos) << refusal("sf");
+  write("ss", "{" + rest + ", \"encoder_sign\": [-1, \"-1\", 1]}");
+  EXPECT_NE(refusal("ss").find("encoder_sign[1] (t2) must be +1 or -1"),
+            std::string::npos) << refusal("ss");
+  write("sn", "{" + rest + ", \"encoder_sign\": -1}");
+  EXPECT_NE(refusal("sn").find("'encoder_sign' must be an array of 3 signs"),
+            std::string::npos) << refusal("sn");
+  write("i4", "{" + rest + ", \"inkwell_t123_rad\": [0, 4, 0]}");
+  EXPECT_NE(refusal("i4").find("inkwell_t123_rad[1] (t2) = 4 rad"),
+            std::string::npos) << refusal("i4");
+  write("ix", "{" + rest + ", \"inkwell_t123_rad\": [0, 0]}");
+  EXPECT_NE(refusal("ix").find("'inkwell_t123_rad' must be an array of 3 numbers"),
+            std::string::npos) << refusal("ix");
+  // check_calibration refuses the same in memory, and nothing is stored
+  hw::OmniCalibration c = plausible();
+  c.encoder_sign[0] = 3;
+  StoredCalibration s;
+  s.calibration = c;
+  s.serial = "badsign";
+  try {
+    save_calibration(s);
+    ADD_FAILURE() << "a sign of 3 was stored";
+  } catch (const CalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("encoder_sign[0] (t1) = 3"),
+              std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(calibration_path("badsign")));
 }
 
 TEST_F(StoreTest, MalformedFilesAreRefusedNamingTheField) {

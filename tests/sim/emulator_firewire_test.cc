@@ -154,7 +154,7 @@ TEST(EmulatorFirewire, NodeIsTheEmulatorsSerialOnSensablesVendor) {
   // not started: the device is not there
   std::uint8_t buf[64];
   std::size_t size = 0;
-  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kDisconnected);
+  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kDisconnected);
 }
 
 TEST(EmulatorFirewire, BadFactoryOptionsAreNamed) {
@@ -192,7 +192,7 @@ TEST(EmulatorFirewire, PacketsCarryTheEmulatorsRawReadings) {
     emu->advance();
     DeviceState a;
     ASSERT_EQ(emu->read_state(&a), DeviceError::kOk) << i;
-    ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kOk) << i;
+    ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kOk) << i;
     ASSERT_EQ(size, fw::kStatePacketBytes);
     const fw::StatePacket p = packet_of(buf, size);
     EXPECT_EQ(p.magic, kEmulatorStateMagic);
@@ -325,17 +325,17 @@ TEST(EmulatorFirewire, WrongLengthsAreBadPacketsThenDataAgain) {
   t.start();
   std::uint8_t buf[64];
   std::size_t size = 0;
-  ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kOk);
+  ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kOk);
   t.inject({WireFaultKind::kLength, 0.0, 0.0, 3});
   std::vector<std::size_t> sizes;
   for (int i = 0; i < 3; ++i) {
     t.emulator()->advance();
-    EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kBadPacket);
+    EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kBadPacket);
     sizes.push_back(size);
   }
   EXPECT_EQ(sizes, (std::vector<std::size_t>{43, 45, 43}));
   t.emulator()->advance();
-  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kOk);
+  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kOk);
   EXPECT_EQ(size, 44u);
   EXPECT_EQ(t.stats().bad_packets, 3u);
   EXPECT_EQ(t.stats().timeouts, 0u);
@@ -366,8 +366,8 @@ TEST(EmulatorFirewire, BusResetUntilRecoverWithTheMotorsAtZero) {
   std::uint8_t buf[64];
   std::size_t size = 0;
   // at the transport: reset on every call until recover()
-  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kBusReset);
-  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kBusReset);
+  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kBusReset);
+  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kBusReset);
   std::uint8_t cmd[fw::kCommandPacketBytes];
   fw::CommandPacket c;
   c.motor = {0x0fff, 0x0fff, 0x0fff};
@@ -385,7 +385,7 @@ TEST(EmulatorFirewire, BusResetUntilRecoverWithTheMotorsAtZero) {
   EXPECT_EQ(t.stats().bus_resets, 1u);
   EXPECT_EQ(t.recover(), TransportStatus::kOk);
   EXPECT_EQ(t.stats().recoveries, 1u);
-  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kOk);
+  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kOk);
 
   // through the device: one tick without a reading (it recovers), then data
   // and torque again, each in the next tick
@@ -455,7 +455,7 @@ TEST(EmulatorFirewire, LatePacketsAreOldThenFreshAgain) {
   std::size_t size = 0;
   long k = 50;  // periods run
   for (long i = 0; i < k; ++i) emu->advance();
-  ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kOk);
+  ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kOk);
   // fresh: the time field is the clock's, k periods of 1 ms in us
   EXPECT_EQ(packet_of(buf, size).time, static_cast<std::uint32_t>(1000 * k));
   t.inject({WireFaultKind::kLate, 0.0, 0.3005, 20});
@@ -465,7 +465,7 @@ TEST(EmulatorFirewire, LatePacketsAreOldThenFreshAgain) {
     emu->advance();
     ++k;
     ASSERT_TRUE(emu->truth().late) << n;
-    ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kOk) << n;
+    ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kOk) << n;
     ASSERT_EQ(packet_of(buf, size).time, static_cast<std::uint32_t>(1000 * (k - 20))) << n;
   }
   // then fresh again from the next period (the old test: within 5 ms)
@@ -473,7 +473,7 @@ TEST(EmulatorFirewire, LatePacketsAreOldThenFreshAgain) {
     emu->advance();
     ++k;
     ASSERT_FALSE(emu->truth().late) << n;
-    ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kOk) << n;
+    ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kOk) << n;
     ASSERT_EQ(packet_of(buf, size).time, static_cast<std::uint32_t>(1000 * k)) << n;
   }
   t.stop();
@@ -491,7 +491,7 @@ TEST(EmulatorFirewire, TheTimeFieldIsRoundedNotTruncated) {
   int checked = 0;
   for (int k = 1; k <= 1100; ++k) {
     emu->advance();
-    ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kOk) << k;
+    ASSERT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kOk) << k;
     if (k < 1000) continue;
     const fw::StatePacket p = packet_of(buf, size);
     EXPECT_EQ(p.time, 1000u * static_cast<unsigned>(k)) << "period " << k;
@@ -588,7 +588,7 @@ TEST(EmulatorFirewireRealtime, PacketsStreamFromThePhysicsThread) {
   std::uint32_t last_counter = 0, last_time = 0;
   const double end_s = monotonic_now_s() + 0.3;
   while (monotonic_now_s() < end_s) {
-    const TransportStatus st = t.receive(buf, sizeof buf, &size, 2e-3);
+    const TransportStatus st = t.receive(buf, sizeof buf, &size, 2e-3, nullptr);
     if (st == TransportStatus::kOk) {
       const fw::StatePacket p = packet_of(buf, size);
       if (p.counter != last_counter + 1 || p.time < last_time) ++out_of_order;
@@ -609,7 +609,7 @@ TEST(EmulatorFirewireRealtime, PacketsStreamFromThePhysicsThread) {
   EXPECT_EQ(bad, 0);
   EXPECT_EQ(out_of_order, 0);
   EXPECT_TRUE(ok > 0 || !cause.empty()) << timeouts << " time-outs, no cause named";
-  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3), TransportStatus::kDisconnected);
+  EXPECT_EQ(t.receive(buf, sizeof buf, &size, 2e-3, nullptr), TransportStatus::kDisconnected);
 }
 
 // A physics thread that cannot keep up (10^4 simulated s per wall s: see
@@ -626,7 +626,7 @@ TEST(EmulatorFirewireRealtime, StarvedPhysicsIsATimeoutNotADisconnect) {
   long timeouts = 0, bad = 0;
   const bool starved = wait_for(
       [&] {
-        const TransportStatus st = t.receive(buf, sizeof buf, &size, 2e-3);
+        const TransportStatus st = t.receive(buf, sizeof buf, &size, 2e-3, nullptr);
         if (st == TransportStatus::kTimeout) ++timeouts;
         if (st != TransportStatus::kTimeout && st != TransportStatus::kOk) ++bad;
         return timeouts > 0 && t.emulator()->truth().lag_periods > 0;

@@ -501,8 +501,11 @@ TEST(Emulator, RawReadingsDecodeToTheReportedAngles) {
   const EmulatorTruth t = emu.truth();
   ASSERT_EQ(s.timestamp_s, t.wall_s);  // the same period's reading and truth
   const hw::OmniCalibration f = emu.factory_calibration();
-  // §9.2 by hand: t_i = offset_i + sign_i 2 pi count / 15000, sign (-1,1,1)
-  const double sign[3] = {-1, 1, 1};
+  // §9.2 by hand: t_i = offset_i + sign_i 2 pi count / 15000, with the
+  // drivers' signs (-1, -1, +1), which the emulator's Omni has
+  const double sign[3] = {-1, -1, 1};
+  EXPECT_EQ(f.encoder_sign, (std::array<int, 3>{-1, -1, 1}));
+  EXPECT_LT(f.pot_gain_rad[1], 0.0);  // and t5's pot turns the other way
   for (int i = 0; i < 3; ++i) {
     const auto k = static_cast<std::size_t>(i);
     EXPECT_NEAR(f.encoder_offset_rad[k] + sign[i] * 2 * kPi * s.encoder_counts[k] / 15000,

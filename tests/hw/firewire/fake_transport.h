@@ -57,8 +57,10 @@ class FakeTransport final : public Transport {
   // sent packets, in order (kSent at most; n_sent counts them all)
   std::array<std::array<std::uint8_t, kCommandPacketBytes>, kSent> sent{};
   std::atomic<std::size_t> n_sent{0};
-  // the index of the last packet sent before stop() was first called
+  // the index of the last packet sent before stop() was first called, and
+  // before the last recover()
   std::atomic<long> sent_at_stop{-1};
+  std::atomic<long> sent_at_recover{-1};
 
   CommandPacket sent_command(std::size_t i) const {
     CommandPacket c;
@@ -79,9 +81,15 @@ class FakeTransport final : public Transport {
   void stop() noexcept override {
     if (stop_calls++ == 0) sent_at_stop = static_cast<long>(n_sent) - 1;
   }
+  // what each good receive() says arrived with its packet (ReceiveInfo)
+  std::uint32_t arrived_per_packet = 1;
+  std::uint32_t late_per_packet = 0;
+
   TransportStatus receive(std::uint8_t* buf, std::size_t capacity,
-                          std::size_t* size, double) noexcept override {
+                          std::size_t* size, double,
+                          ReceiveInfo* info) noexcept override {
     ++receive_calls;
+    if (info != nullptr) *info = ReceiveInfo{};
     if (stream) {
       ++stream_packet.counter;
       stream_packet.encoders[0] =
@@ -89,6 +97,7 @@ class FakeTransport final : public Transport {
       if (capacity < kStatePacketBytes) return TransportStatus::kIo;
       encode_state(stream_packet, buf);
       *size = kStatePacketBytes;
+      if (info != nullptr) *info = ReceiveInfo{arrived_per_packet, late_per_packet};
       return TransportStatus::kOk;
     }
     if (head_ == tail_) return TransportStatus::kTimeout;
@@ -97,6 +106,7 @@ class FakeTransport final : public Transport {
     if (it.size > capacity) return TransportStatus::kIo;
     std::memcpy(buf, it.bytes.data(), it.size);
     *size = it.size;
+    if (info != nullptr) *info = ReceiveInfo{arrived_per_packet, late_per_packet};
     return TransportStatus::kOk;
   }
   TransportStatus send(const std::uint8_t* data,
@@ -109,6 +119,7 @@ class FakeTransport final : public Transport {
   }
   TransportStatus recover() noexcept override {
     ++recover_calls;
+    sent_at_recover = static_cast<long>(n_sent) - 1;
     return recover_result;
   }
   TransportStats stats() const noexcept override { return {}; }

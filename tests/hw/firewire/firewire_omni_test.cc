@@ -55,9 +55,10 @@ TEST(FirewireOmni, AnglesAreTheCalibratedRawReadings) {
   for (int i = 0; i < 6; ++i) {
     EXPECT_DOUBLE_EQ(r.st.q_device_rad[i], expected[i]) << "t" << i + 1;
   }
-  // and by hand: 1500 counts = 1/10 rev; t1 counts the other way (§9.2)
+  // and by hand: 1500 counts = 1/10 rev; with the drivers' signs t1 and
+  // t2 count the other way (§9.2)
   EXPECT_NEAR(r.st.q_device_rad[0], 0.1 - 2 * kPi / 10, 1e-12);
-  EXPECT_NEAR(r.st.q_device_rad[1], -0.2 - 2 * kPi / 5, 1e-12);  // -3000
+  EXPECT_NEAR(r.st.q_device_rad[1], -0.2 + 2 * kPi / 5, 1e-12);  // -3000
   EXPECT_NEAR(r.st.q_device_rad[2], 0.3 + kPi, 1e-12);           // 7500
   EXPECT_NEAR(r.st.q_device_rad[3], 0.002 * 100 - 1.0, 1e-12);
   EXPECT_NEAR(r.st.q_device_rad[4], 0.003 * 1024 - 2.0, 1e-12);
@@ -131,6 +132,107 @@ TEST(FirewireOmni, EncoderUnwrapsAcrossTheInt16WrapOverPackets) {
   }
   // the angle follows the unwrapped count: 33800 counts on t1
   EXPECT_NEAR(r.st.q_device_rad[0], 0.1 - 2 * kPi * 33800 / 15000, 1e-12);
+}
+
+TEST(FirewireOmni, WhatArrivedTellsLostFromSupersededAndLate) {
+  // The transport takes every packet that arrived and hands over the
+  // newest. Two arrive each tick here (2000 packets a second read at 1 kHz):
+  // a counter that steps by 2 loses nothing.
+  Rig r;
+  r.t->arrived_per_packet = 2;
+  for (std::uint32_t c : {2u, 4u, 6u, 8u}) {
+    r.t->push_packet(make_packet(c, {0, 0, 0}, {0, 0, 0}));
+  }
+  for (int k = 0; k < 4; ++k) ASSERT_EQ(r.read(), DeviceError::kOk);
+  FirewireOmniStats s = r.omni.stats();
+  EXPECT_EQ(s.packets, 4u);
+  EXPECT_EQ(s.lost_packets, 0u);
+  EXPECT_EQ(s.superseded_packets, 4u);
+  EXPECT_EQ(s.late_packets, 0u);
+  // a step of 5 with 2 arrived: 3 never came
+  r.t->push_packet(make_packet(13, {0, 0, 0}, {0, 0, 0}));
+  ASSERT_EQ(r.read(), DeviceError::kOk);
+  EXPECT_EQ(r.omni.stats().lost_packets, 3u);
+  // a tick that found two packets of which one had waited a period: late,
+  // and not lost
+  r.t->arrived_per_packet = 2;
+  r.t->late_per_packet = 1;
+  r.t->push_packet(make_packet(15, {0, 0, 0}, {0, 0, 0}));
+  ASSERT_EQ(r.read(), DeviceError::kOk);
+  s = r.omni.stats();
+  EXPECT_EQ(s.lost_packets, 3u);
+  EXPECT_EQ(s.late_packets, 1u);
+  EXPECT_EQ(s.superseded_packets, 6u);
+}
+
+TEST(FirewireOmni, TheInkwellSetsTheEncoderOffsets) {
+  // Re-homing as the drivers do it: a docked packet makes t1..t3 read the
+  // calibration's inkwell pose, whatever the offsets were; out of the
+  // inkwell the angles follow the counts from there.
+  Rig r;
+  OmniCalibration cal = test_calibration();
+  cal.inkwell_t123_rad = {0.05, -0.6, -0.5};
+  r.omni.set_calibration(cal);
+  StatePacket p = make_packet(1, {1234, -4321, 777}, {0, 0, 0});
+  p.status = kStateButton1Released | kStateButton2Released;  // docked
+  r.t->push_packet(p);
+  p.counter = 2;  // still docked, counts moved a little as it settles
+  p.encoders = {1240, -4320, 770};
+  r.t->push_packet(p);
+  StatePacket out = make_packet(3, {1240 + 1500, -4320 - 1500, 770 + 1500},
+                                {0, 0, 0});  // undocked, a tenth of a turn each
+  r.t->push_packet(out);
+  ASSERT_EQ(r.read(), DeviceError::kOk);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(r.st.q_device_rad[i], cal.inkwell_t123_rad[static_cast<std::size_t>(i)],
+                1e-12) << "t" << i + 1;
+  }
+  ASSERT_EQ(r.read(), DeviceError::kOk);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(r.st.q_device_rad[i], cal.inkwell_t123_rad[static_cast<std::size_t>(i)],
+                1e-12) << "t" << i + 1;
+  }
+  ASSERT_EQ(r.read(), DeviceError::kOk);
+  // signs (-1, -1, +1): +1500 on t1 is -0.1 turn, -1500 on t2 +0.1 turn
+  EXPECT_NEAR(r.st.q_device_rad[0], 0.05 - 2 * kPi / 10, 1e-12);
+  EXPECT_NEAR(r.st.q_device_rad[1], -0.6 + 2 * kPi / 10, 1e-12);
+  EXPECT_NEAR(r.st.q_device_rad[2], -0.5 + 2 * kPi / 10, 1e-12);
+  const FirewireOmniStats s = r.omni.stats();
+  EXPECT_EQ(s.rehomes, 1u);  // one stay in the inkwell
+  // the calibration in use has the inkwell's offsets; pots untouched
+  const OmniCalibration in_use = r.omni.calibration();
+  const auto expected = docked_encoder_offsets({1240, -4320, 770}, cal);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_DOUBLE_EQ(in_use.encoder_offset_rad[i], expected[i]) << i;
+    EXPECT_EQ(in_use.pot_gain_rad[i], cal.pot_gain_rad[i]) << i;
+  }
+  // a calibration set afterwards is taken at the next tick
+  OmniCalibration other = cal;
+  other.encoder_offset_rad = {0.5, 0.5, 0.5};
+  r.omni.set_calibration(other);
+  EXPECT_EQ(r.omni.calibration().encoder_offset_rad, other.encoder_offset_rad);
+  r.t->push_packet(make_packet(4, {0, 0, 0}, {0, 0, 0}));
+  ASSERT_EQ(r.read(), DeviceError::kOk);
+  EXPECT_DOUBLE_EQ(r.st.q_device_rad[0], 0.5);
+}
+
+TEST(FirewireOmni, WithoutRehomingTheInkwellChangesNothing) {
+  auto t = std::make_unique<FakeTransport>();
+  FirewireOmniOptions o = test_options();
+  o.rehome_in_inkwell = false;
+  FirewireOmni omni(t.get(), o);
+  StatePacket p = make_packet(1, {1234, -4321, 777}, {0, 0, 0});
+  p.status = kStateButton1Released | kStateButton2Released;  // docked
+  t->push_packet(p);
+  DeviceState st;
+  ASSERT_EQ(omni.read_state(&st), DeviceError::kOk);
+  EXPECT_TRUE(st.docked);
+  const Joints expected = angles_from_raw({1234, -4321, 777}, {0, 0, 0},
+                                          test_calibration());
+  EXPECT_DOUBLE_EQ(st.q_device_rad[0], expected[0]);
+  EXPECT_EQ(omni.stats().rehomes, 0u);
+  EXPECT_EQ(omni.calibration().encoder_offset_rad,
+            test_calibration().encoder_offset_rad);
 }
 
 TEST(FirewireOmni, CounterGapsAreLostPackets) {
@@ -220,6 +322,12 @@ TEST(FirewireOmni, BusResetRecoversAndReseedsTheUnwrap) {
   EXPECT_EQ(r.read(), DeviceError::kNotConnected);
   EXPECT_EQ(r.st.present, 0u);
   EXPECT_EQ(r.t->recover_calls.load(), 1);
+  // zero words with the motors off went out before the recovery
+  ASSERT_GE(r.t->sent_at_recover.load(), 0);
+  const CommandPacket before = r.t->sent_command(
+      static_cast<std::size_t>(r.t->sent_at_recover.load()));
+  EXPECT_FALSE(before.motors_on());
+  EXPECT_EQ(before.motor[0], kMotorWordZero);
   ASSERT_EQ(r.read(), DeviceError::kOk);
   // re-seeded: 5, not unwrap_encoder(40000, 5) = 65541
   EXPECT_EQ(r.st.encoder_counts[0], 5);
@@ -349,15 +457,25 @@ TEST(FirewireOmni, OptionsAreValidated) {
   EXPECT_FALSE(d.calibrated());
 }
 
-TEST(FirewireOmni, NominalCalibrationIsTheSourcesExampleLine) {
-  // §9.2: theta = 5.48 r - 2.74 with r = a / (a + b)
+TEST(FirewireOmni, NominalCalibrationIsTheDriversLines) {
+  // §9.2: t4 = 5.48 r - 2.74, t5 = -5.28 r + 2.64, t6 = 4.76 r - 2.38 with
+  // r = a / (a + b); encoders (-1, -1, +1)
   const OmniCalibration c = nominal_calibration();
   EXPECT_NO_THROW(c.validate());
+  const double at_one[3] = {5.48 - 2.74, -5.28 + 2.64, 4.76 - 2.38};
+  const double at_zero[3] = {-2.74, 2.64, -2.38};
   for (std::size_t i = 0; i < 3; ++i) {
-    EXPECT_NEAR(c.pot_gain_rad[i] * kPotCodeMax + c.pot_offset_rad[i], 2.74,
-                1e-12);  // r = 1
-    EXPECT_DOUBLE_EQ(c.pot_offset_rad[i], -2.74);  // r = 0
+    EXPECT_NEAR(c.pot_gain_rad[i] * kPotCodeMax + c.pot_offset_rad[i], at_one[i],
+                1e-12) << i;  // r = 1
+    EXPECT_DOUBLE_EQ(c.pot_offset_rad[i], at_zero[i]) << i;  // r = 0
+    EXPECT_DOUBLE_EQ(c.encoder_offset_rad[i], 0.0) << i;
   }
+  EXPECT_LT(c.pot_gain_rad[1], 0.0);  // t5's pot turns the other way
+  EXPECT_EQ(c.encoder_sign, (std::array<int, 3>{-1, -1, 1}));
+  // the half-way code of a pot reads the middle of its line
+  const Joints mid = angles_from_raw({0, 0, 0}, {1024, 1024, 1024}, c);
+  EXPECT_NEAR(mid[3], 5.48 * 1024 / 2047 - 2.74, 1e-12);
+  EXPECT_NEAR(mid[4], -5.28 * 1024 / 2047 + 2.64, 1e-12);
 }
 
 TEST(FirewireOmni, ServoPathAllocatesNothing) {
