@@ -49,11 +49,16 @@ std::string td(const std::string& text, const std::string& cls = "") {
 }
 std::string th(const std::string& text) { return "<th>" + escape(text) + "</th>"; }
 
-// a figure, or a note where it is missing
-std::string figure(const std::string& svg, const std::string& caption) {
-  std::string s = "<figure>\n";
+// a figure, or a note where it is missing. `id` names the figure on the page
+// and prefixes every id inside its SVG; `file` is the same SVG's file
+// relative to the report (the browser test draws it standalone and compares).
+std::string figure(const std::string& svg, const std::string& caption,
+                   const std::string& id, const std::string& file) {
+  std::string s = "<figure id=\"fig-" + escape(id) + "\"" +
+                  (file.empty() ? "" : " data-file=\"" + escape(file) + "\"") +
+                  ">\n";
   s += svg.empty() ? "<p class=\"note\">" + escape(caption) + ": not available</p>\n"
-                   : inline_svg(svg);
+                   : inline_svg(svg, id + "-");
   return s + "<figcaption>" + escape(caption) + "</figcaption>\n</figure>\n";
 }
 
@@ -175,10 +180,13 @@ std::string case_section(const ReportCase& c) {
   s += "<h3>Figures</h3>\n";
   s += figure(c.force_field_svg,
               c.name + ": the commanded force along the RM wrist-centre "
-              "trajectory (device frame, mm)");
+              "trajectory (device frame, mm)",
+              c.name + "-force-field", c.name + "/force_field.svg");
   s += figure(c.views_svg, c.name + ": the RM off the path and on it "
-                           "(device frame, mm)");
-  s += figure(c.history_svg, c.name + ": error and force against time");
+                           "(device frame, mm)",
+              c.name + "-views", c.name + "/views.svg");
+  s += figure(c.history_svg, c.name + ": error and force against time",
+              c.name + "-history", c.name + "/history.svg");
   s += "<figure>\n";
   if (c.render_png) {
     s += "<img alt=\"" + escape(c.name) + " render\" src=\"data:image/png;base64," +
@@ -337,9 +345,37 @@ std::string base64(const std::string& bytes) {
   return out;
 }
 
-std::string inline_svg(const std::string& svg_document) {
+std::string inline_svg(const std::string& svg_document,
+                       const std::string& id_prefix) {
   const std::size_t start = svg_document.find("<svg");
-  return start == std::string::npos ? std::string() : svg_document.substr(start);
+  if (start == std::string::npos) return std::string();
+  const std::string svg = svg_document.substr(start);
+  if (id_prefix.empty()) return svg;
+  // the three forms the project's SVG writers use: an attribute id="x"
+  // (after white space, so that data-id= and the like are left alone), a
+  // paint or clip reference url(#x), and a link href="#x" / xlink:href="#x"
+  std::string out;
+  out.reserve(svg.size() + svg.size() / 20);
+  std::size_t i = 0;
+  while (i < svg.size()) {
+    std::size_t skip = 0;
+    if ((svg[i] == ' ' || svg[i] == '\n' || svg[i] == '\t') &&
+        svg.compare(i + 1, 4, "id=\"") == 0) {
+      skip = 5;
+    } else if (svg.compare(i, 5, "url(#") == 0) {
+      skip = 5;
+    } else if (svg.compare(i, 7, "href=\"#") == 0) {
+      skip = 7;
+    }
+    if (skip == 0) {
+      out += svg[i++];
+      continue;
+    }
+    out.append(svg, i, skip);
+    out += id_prefix;
+    i += skip;
+  }
+  return out;
 }
 
 std::string report_html(const ReportInputs& in) {
@@ -393,9 +429,11 @@ std::string report_html(const ReportInputs& in) {
        escape(st.precision_case.empty() ? "not run" : st.precision_case) +
        ")</h2>\n";
   s += figure(st.precision_svg, "trajectory error (RMS, mm) against wall "
-                                "time (s), per integrator and physics step");
+                                "time (s), per integrator and physics step",
+              "precision", "study/precision.svg");
   s += figure(st.precision_order_svg, "trajectory error against the physics "
-                                      "step h, with the fitted orders");
+                                      "step h, with the fitted orders",
+              "precision-order", "study/precision_order.svg");
   if (!st.precision_csv.empty()) {
     s += "<details><summary>every run (precision.csv)</summary>\n" +
          csv_table(st.precision_csv, "precision") + "</details>\n";
@@ -404,7 +442,8 @@ std::string report_html(const ReportInputs& in) {
   s += "<section id=\"stability\">\n<h2>Stability map of the sampled-data "
        "wall</h2>\n<p>" + escape(st.stability_note) + "</p>\n";
   s += figure(st.stability_map_svg, "K_crit (N/m) against the virtual "
-                                    "damping B (N s/m), per delay");
+                                    "damping B (N s/m), per delay",
+              "stability-map", "study/stability_map.svg");
   if (!st.stability_map_csv.empty()) {
     s += "<details><summary>the map (stability_map.csv)</summary>\n" +
          csv_table(st.stability_map_csv, "stability") + "</details>\n";
@@ -416,7 +455,8 @@ std::string report_html(const ReportInputs& in) {
   } else {
     s += extremes_table(st.extremes);
   }
-  s += figure(st.extremes_svg, "the passivity observer's energy per scenario (mJ)");
+  s += figure(st.extremes_svg, "the passivity observer's energy per scenario (mJ)",
+              "extremes", "study/extremes.svg");
   s += "</section>\n";
   s += "<p class=\"summary\">Claims passed: " + std::to_string(tally.passed) +
        "/" + std::to_string(tally.total) + "</p>\n</body>\n</html>\n";

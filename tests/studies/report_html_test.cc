@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <string>
 #include <vector>
@@ -191,8 +192,29 @@ TEST(ReportHtmlTest, RealRunsOfTheSixCasesAreAllOnThePage) {
   EXPECT_EQ(testing::count(html, "render unavailable: no renderer in this build"), 6u);
   // the force field of every case: one panel for the circles (cases 1-4),
   // three for the spheres (5, 6)
-  EXPECT_EQ(testing::count(html, "id=\"ff-xy\""), 6u);
-  EXPECT_EQ(testing::count(html, "id=\"ff-zy\""), 2u);
+  EXPECT_EQ(testing::count(html, "-force-field-ff-xy\""), 6u);
+  EXPECT_EQ(testing::count(html, "-force-field-ff-zy\""), 2u);
+  // every id on the page once: the figures' own ids are prefixed per figure
+  std::map<std::string, int> ids;
+  const std::regex id_attr(R"re(\sid="([^"]*)")re");
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), id_attr);
+       it != std::sregex_iterator(); ++it) {
+    ++ids[(*it)[1].str()];
+  }
+  EXPECT_GT(ids.size(), 50u);
+  for (const auto& [id, n] : ids) EXPECT_EQ(n, 1) << id;
+}
+
+TEST(ReportHtmlTest, InlineSvgPrefixesItsIdsAndTheirReferences) {
+  const std::string svg =
+      "<svg><defs><clipPath id=\"plot-clip\"><rect/></clipPath></defs>"
+      "<g clip-path=\"url(#plot-clip)\" data-id=\"keep\"><use href=\"#m\"/>"
+      "<use xlink:href=\"#m\"/><a href=\"https://x\"/></g>\n<path\nid=\"m\"/></svg>";
+  EXPECT_EQ(inline_svg(svg, "f1-"),
+            "<svg><defs><clipPath id=\"f1-plot-clip\"><rect/></clipPath></defs>"
+            "<g clip-path=\"url(#f1-plot-clip)\" data-id=\"keep\"><use href=\"#f1-m\"/>"
+            "<use xlink:href=\"#f1-m\"/><a href=\"https://x\"/></g>\n<path\nid=\"f1-m\"/></svg>");
+  EXPECT_EQ(inline_svg(svg), svg);
 }
 
 TEST(ReportHtmlTest, LoadNamesAMissingSummary) {
