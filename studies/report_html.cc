@@ -89,8 +89,8 @@ std::string csv_table(const std::string& csv, const std::string& cls) {
 }
 
 const char* const kStyle =
-    "body{font-family:sans-serif;margin:1.5em auto;max-width:1200px;"
-    "color:#222;padding:0 1em}"
+    "body{font-family:sans-serif;margin:1.5em auto;max-width:1600px;"
+    "color:#222;padding:0 1em}p,li,details{max-width:62em}"
     "h1{font-size:1.6em}h2{border-bottom:2px solid #ccc;margin-top:2em}"
     "table{border-collapse:collapse;margin:0.5em 0;font-size:0.9em}"
     "td,th{border:1px solid #ccc;padding:2px 6px;text-align:left}"
@@ -98,7 +98,7 @@ const char* const kStyle =
     "td.partial{background:#fdf1cf;color:#750}"
     "td.fail,tr.fail td{background:#fbd9d9;font-weight:bold;color:#900}"
     "span.fail{color:#900;font-weight:bold}span.pass{color:#060}"
-    ".note{color:#775;font-style:italic}.scroll{overflow-x:auto}"
+    "p.note{color:#775;font-style:italic}div.scroll{overflow-x:auto}"
     "figure{margin:1em 0}figcaption{font-size:0.85em;color:#555}"
     "svg{max-width:100%;height:auto}img{max-width:100%}"
     "details{margin:0.5em 0}";
