@@ -10,6 +10,7 @@
 
 #include "report/svg_text.h"
 #include "studies/force_field_svg.h"
+#include "studies/thesis_svg.h"
 
 namespace vmh::studies {
 namespace {
@@ -228,6 +229,11 @@ std::string case_section(const ReportCase& c) {
               c.name + ": the commanded force along the RM wrist-centre "
               "trajectory (device frame, mm)",
               c.name + "-force-field", c.name + "/force_field.svg");
+  s += figure(c.thesis_svg,
+              c.name + ": theta_V and theta_R against time, and the RM "
+              "wrist centre's trajectory in the mechanism's plane coloured by "
+              "time (the thesis's figures)",
+              c.name + "-thesis", c.name + "/thesis.svg");
   s += figure(c.views_svg, c.name + ": the RM off the path and on it "
                            "(device frame, mm)",
               c.name + "-views", c.name + "/views.svg");
@@ -351,8 +357,9 @@ ReportCase load_report_case(const std::string& dir, const std::string& name,
                              ": the VM's parameters: " + e.what());
   }
   try {
-    c.force_field_svg = force_field_svg(
-        force_samples_from_csv(read_text(d / "trace.csv")), path);
+    const std::string trace = read_text(d / "trace.csv");
+    c.force_field_svg = force_field_svg(force_samples_from_csv(trace), path);
+    c.thesis_svg = thesis_svg(thesis_samples_from_csv(trace), path);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error((d / "trace.csv").string() + ": " + e.what());
   }

@@ -41,6 +41,7 @@ struct ReportCase {
   std::string name;
   nlohmann::json summary;  // summary.json
   std::string force_field_svg, views_svg, history_svg;
+  std::string thesis_svg;  // theta_V, theta_R against time; the trajectory
   std::optional<std::string> render_png;  // PNG bytes
   std::string render_note;                // why there is no render
 };
