@@ -22,6 +22,7 @@ import base64
 import json
 import os
 import pathlib
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -236,6 +237,7 @@ def main():
         main_page = chrome.page(*VIEWPORT)
     except Exception as e:  # no browser to drive: skipped, not passed
         print(f"Chromium could not be started: {e}")
+        shutil.rmtree(work, ignore_errors=True)
         return 77
     failures = []
     try:
@@ -289,6 +291,8 @@ def main():
         failures += problems_in(chrome, main_page)
     finally:
         chrome.close()
+    # the report it made and the browser's profile: nothing is left behind
+    shutil.rmtree(work, ignore_errors=True)
     failures = list(dict.fromkeys(failures))
     for f in failures:
         print("FAIL " + f)
