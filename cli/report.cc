@@ -263,6 +263,13 @@ void run(const ReportCli& o) {
 #endif
   for (const sim::CaseEntry& c : sim::thesis_cases()) {
     in.cases.push_back(studies::load_report_case(dir.string(), c.name, render));
+    // the force field and the thesis's figures exist only here: kept beside
+    // the case's other SVGs,
+    // so that they can be opened (and compared) standalone
+    report::write_file_in((dir / c.name).string(), "force_field.svg",
+                          in.cases.back().force_field_svg);
+    report::write_file_in((dir / c.name).string(), "thesis.svg",
+                          in.cases.back().thesis_svg);
   }
   studies::ReportStudies& st = in.studies;
   st.precision_case = precision.name;

@@ -147,10 +147,10 @@ const std::vector<ParamSpec>& case_fields() {
               })
           .non_negative()
           .ctl("--kpos"),
-      numeric("controller", "k_ornt_multiple", 1, "0", "N/mm",
+      numeric("controller", "k_ornt_multiple", 1, "0", "N/rad",
               "K_ornt, the stiffness of the orientation rows, as a multiple "
               "of the circumference: K_ornt = multiple x 2 pi L N mm/rad "
-              "(eq. 3.28)",
+              "(eq. 3.28), so the multiple is in N/rad",
               [](CaseParams* p, const ParamValue& v) {
                 p->controller.k_ornt_multiple = item(v);
               })

@@ -71,8 +71,9 @@ std::string panel(const std::vector<ForceSample>& s,
        attr("y", px(top + kPanel_px + 32)) + " text-anchor=\"middle\">" +
        escape(std::string(axis_name(v.across)) + " (mm, device frame)") +
        "</text>\n";
-  g += "<text" + attr("x", px(left - 12)) + attr("y", px(top + kPanel_px / 2)) +
-       attr("transform", "rotate(-90 " + px(left - 12) + " " +
+  // the axis's name left of its tick labels, both outside the frame
+  g += "<text" + attr("x", px(left - 36)) + attr("y", px(top + kPanel_px / 2)) +
+       attr("transform", "rotate(-90 " + px(left - 36) + " " +
                              px(top + kPanel_px / 2) + ")") +
        " text-anchor=\"middle\">" +
        escape(std::string(axis_name(v.up)) + " (mm)") + "</text>\n";
@@ -92,8 +93,8 @@ std::string panel(const std::vector<ForceSample>& s,
       } else {
         g += "<line" + attr("x1", px(left - 4)) + attr("y1", px(Y(t))) +
              attr("x2", px(left)) + attr("y2", px(Y(t))) +
-             " stroke=\"#444\"/>\n<text" + attr("x", px(left + 3)) +
-             attr("y", px(Y(t) - 2)) + " fill=\"#666\">" + label +
+             " stroke=\"#444\"/>\n<text" + attr("x", px(left - 6)) +
+             attr("y", px(Y(t) + 4)) + " text-anchor=\"end\">" + label +
              "</text>\n";
       }
     }
@@ -171,11 +172,29 @@ std::string force_field_svg(const std::vector<ForceSample>& samples,
     return svg + "<text x=\"10\" y=\"30\">force field: no rows to plot</text>\n</svg>\n";
   }
 
-  // samples evenly in time, and the arrows' scale from the largest force
+  // samples evenly along the trajectory's length, not in time: where the
+  // hand holds still, samples evenly in time pile their arrows on one spot
+  // (issue 31); and the arrows' scale from the largest force
+  std::vector<double> walked(samples.size(), 0.0);  // mm from the first row
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    double d2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = samples[i].p_mm[k] - samples[i - 1].p_mm[k];
+      d2 += d * d;
+    }
+    const double d = std::sqrt(d2);
+    walked[i] = walked[i - 1] + (std::isfinite(d) ? d : 0.0);
+  }
   std::vector<std::size_t> picked;
   const std::size_t n = std::max<std::size_t>(1, arrows);
-  for (std::size_t j = 0; j < n; ++j) {
-    const std::size_t i = (j * samples.size()) / n;
+  const double total = walked.back();
+  for (std::size_t j = 0, i = 0; j < n; ++j) {
+    if (total <= 0.0) {
+      i = (j * samples.size()) / n;  // no motion at all: evenly in time
+    } else {
+      const double at = total * static_cast<double>(j) / static_cast<double>(n);
+      while (i + 1 < samples.size() && walked[i] < at) ++i;
+    }
     if (picked.empty() || picked.back() != i) picked.push_back(i);
   }
   double max_F = 0.0;
@@ -190,7 +209,7 @@ std::string force_field_svg(const std::vector<ForceSample>& samples,
   svg += "<text x=\"" + px(kMargin_px) + "\" y=\"18\" font-size=\"13\">" +
          escape("Commanded force along the path (" + path.vm_kind + ", L = " +
                 num(path.length_mm) + " mm): " + std::to_string(picked.size()) +
-                " samples evenly in time") + "</text>\n";
+                " samples evenly along the trajectory's length") + "</text>\n";
   svg += "<text x=\"" + px(kMargin_px) + "\" y=\"34\">" +
          escape("device frame, mm; arrow 1 N = " + num(mm_per_N) +
                 " mm; blue: the VM's path" +

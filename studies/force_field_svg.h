@@ -1,6 +1,6 @@
 // The commanded force along the path, as the thesis draws it in ch. 4
 // (docs/sources.md §2): arrows of the force F at points of the RM
-// wrist-centre trajectory sampled evenly in time, over the VM's path, in the
+// wrist-centre trajectory sampled evenly along its length, over the VM's path, in the
 // mechanism's plane for the circle (the pivot frame's x-y, the device's x-y
 // for the thesis's cases) and in three projections (x-y, x-z, z-y) for the
 // sphere and the surface. Device frame, mm; the arrows' scale (mm per N) is
@@ -43,7 +43,8 @@ struct ForceFieldPath {
 inline constexpr std::size_t kForceFieldArrows = 72;
 
 // The figure as a standalone SVG 1.1 document. `arrows` samples are taken
-// evenly in time; one whose projected force would be shorter than 2 px is
+// evenly along the trajectory's length (where the hand holds still, evenly
+// in time would pile them up); one whose projected force would be shorter than 2 px is
 // left out (it shows no direction). Empty `samples`: a document that says
 // so.
 std::string force_field_svg(const std::vector<ForceSample>& samples,

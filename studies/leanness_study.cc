@@ -224,10 +224,17 @@ VariantResult variant_result(const VariantLoop& v, const VariantLoop& composed,
                       (m->opt.gravity[0] != 0.0 || m->opt.gravity[1] != 0.0 ||
                        m->opt.gravity[2] != 0.0);
   r.frictionloss_enabled = !(m->opt.disableflags & mjDSBL_FRICTIONLOSS);
+  // a geom can collide when some other geom's bits meet its own
+  // (contype of one & conaffinity of the other, either way); the Omni's
+  // collision class has contype 1 and conaffinity 0 everywhere, so no pair
   r.colliding_geoms = 0;
   for (int g = 0; g < m->ngeom; ++g) {
-    if (m->geom_contype[g] != 0 || m->geom_conaffinity[g] != 0) {
-      ++r.colliding_geoms;
+    for (int h = 0; h < m->ngeom; ++h) {
+      if (h != g && ((m->geom_contype[g] & m->geom_conaffinity[h]) != 0 ||
+                     (m->geom_contype[h] & m->geom_conaffinity[g]) != 0)) {
+        ++r.colliding_geoms;
+        break;
+      }
     }
   }
   r.max_deviation_mm = 0.0;

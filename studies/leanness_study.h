@@ -81,7 +81,7 @@ struct VariantResult {
   double physics_slowdown = 1.0;
   // structural facts, read from the model and data the run used
   bool contact_enabled = false;
-  int colliding_geoms = 0;     // geoms with contype or conaffinity set
+  int colliding_geoms = 0;     // geoms some other geom's contype/conaffinity meets
   bool gravity_enabled = false;
   bool frictionloss_enabled = false;
   double mean_ncon = 0.0;      // contacts per servo tick (after its steps)

@@ -552,12 +552,12 @@ std::string history_svg(const std::vector<TickRecord>& rows,
   const char* const kColor[3] = {"#d62728", "#2ca02c", "#1f77b4"};
   const char* const kAxis[3] = {"x", "y", "z"};
   std::vector<HistoryPanel> panels(3);
-  panels[0].ylabel = "(a) p - X(theta_V), mm";
-  panels[0].heading = "(a) p - X(theta_V), mm";
-  panels[1].ylabel = "(b) p - X(theta_R), mm";
-  panels[1].heading = "(b) p - X(theta_R), mm";
-  panels[2].ylabel = "(c) force F, N";
-  panels[2].heading = "(c) commanded force, N";
+  panels[0].ylabel = "(a) p - X(theta_V) (mm)";
+  panels[0].heading = "(a) p - X(theta_V) (mm)";
+  panels[1].ylabel = "(b) p - X(theta_R) (mm)";
+  panels[1].heading = "(b) p - X(theta_R) (mm)";
+  panels[2].ylabel = "(c) force F (N)";
+  panels[2].heading = "(c) commanded force (N)";
   for (int i = 0; i < 3; ++i) {
     const std::string c = kAxis[i];
     panels[0].series.push_back({c, kColor[i], "", [i](const TickRecord& r) {
@@ -638,7 +638,7 @@ std::string history_svg(const std::vector<TickRecord>& rows,
                      attr("font-size", "9") + attr("fill", "#555"));
       }
     }
-    draw_axes(svg, f, "t_s", hp.ylabel, k + 1 == panels.size());
+    draw_axes(svg, f, "t (s)", hp.ylabel, k + 1 == panels.size());
     svg.clip_rect("clip-history-" + tag, f.left, f.top, f.width, f.height);
     svg.open("g", attr("clip-path", "url(#clip-history-" + tag + ")"));
     for (const Series& s : hp.series) {

@@ -1,5 +1,6 @@
 #include "studies/report_html.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +10,7 @@
 
 #include "report/svg_text.h"
 #include "studies/force_field_svg.h"
+#include "studies/thesis_svg.h"
 
 namespace vmh::studies {
 namespace {
@@ -49,11 +51,16 @@ std::string td(const std::string& text, const std::string& cls = "") {
 }
 std::string th(const std::string& text) { return "<th>" + escape(text) + "</th>"; }
 
-// a figure, or a note where it is missing
-std::string figure(const std::string& svg, const std::string& caption) {
-  std::string s = "<figure>\n";
+// a figure, or a note where it is missing. `id` names the figure on the page
+// and prefixes every id inside its SVG; `file` is the same SVG's file
+// relative to the report (the browser test draws it standalone and compares).
+std::string figure(const std::string& svg, const std::string& caption,
+                   const std::string& id, const std::string& file) {
+  std::string s = "<figure id=\"fig-" + escape(id) + "\"" +
+                  (file.empty() ? "" : " data-file=\"" + escape(file) + "\"") +
+                  ">\n";
   s += svg.empty() ? "<p class=\"note\">" + escape(caption) + ": not available</p>\n"
-                   : inline_svg(svg);
+                   : inline_svg(svg, id + "-");
   return s + "<figcaption>" + escape(caption) + "</figcaption>\n</figure>\n";
 }
 
@@ -84,8 +91,8 @@ std::string csv_table(const std::string& csv, const std::string& cls) {
 }
 
 const char* const kStyle =
-    "body{font-family:sans-serif;margin:1.5em auto;max-width:1200px;"
-    "color:#222;padding:0 1em}"
+    "body{font-family:sans-serif;margin:1.5em auto;max-width:1600px;"
+    "color:#222;padding:0 1em}p,li,details{max-width:62em}"
     "h1{font-size:1.6em}h2{border-bottom:2px solid #ccc;margin-top:2em}"
     "table{border-collapse:collapse;margin:0.5em 0;font-size:0.9em}"
     "td,th{border:1px solid #ccc;padding:2px 6px;text-align:left}"
@@ -93,10 +100,18 @@ const char* const kStyle =
     "td.partial{background:#fdf1cf;color:#750}"
     "td.fail,tr.fail td{background:#fbd9d9;font-weight:bold;color:#900}"
     "span.fail{color:#900;font-weight:bold}span.pass{color:#060}"
-    ".note{color:#775;font-style:italic}.scroll{overflow-x:auto}"
+    "p.note{color:#775;font-style:italic}div.scroll{overflow-x:auto}"
     "figure{margin:1em 0}figcaption{font-size:0.85em;color:#555}"
     "svg{max-width:100%;height:auto}img{max-width:100%}"
-    "details{margin:0.5em 0}";
+    "details{margin:0.5em 0}"
+    "table.matrix td{font-size:0.85em}table.matrix td.none{background:#fafafa}"
+    "table.matrix a{color:inherit}ul.sides{margin:0;padding-left:1.1em}"
+    "ul.sides li.fail{color:#900;font-weight:bold}p.legend{font-size:0.85em;color:#555}"
+    // print: no heading left at a page's foot, no table, figure or row split
+    "@media print{body{max-width:none;margin:0}h1,h2,h3{break-after:avoid;"
+    "page-break-after:avoid}table,figure,tr,img{break-inside:avoid;"
+    "page-break-inside:avoid}section{break-before:auto}a{color:inherit;"
+    "text-decoration:none}details{display:block}div.scroll{overflow:visible}}";
 
 // the case's key parameters first, every one in a fold below
 std::string parameters(const Json& summary) {
@@ -128,31 +143,68 @@ std::string parameters(const Json& summary) {
   return s;
 }
 
-std::string claims_table(const Json& summary) {
-  std::string s = "<table class=\"claims\">\n<tr>" + th("claim") +
-                  th("value") + th("comparison") + th("threshold") +
-                  th("unit") + th("pass") + th("prediction (law)") +
-                  th("regime") + th("window") +
-                  th("mean distance off the path (mm)") + th("statement") +
-                  "</tr>\n";
-  for (const Json& c : at(summary, "claims")) {
-    const Json& verdict = at(c, "pass");
-    const bool pass = verdict.is_boolean() && verdict.get<bool>();
-    const bool partial = verdict.is_string() && verdict.get<std::string>() == "partial";
-    std::string verdict_text = pass ? "pass" : "FAIL";
-    if (partial) verdict_text = "partial: holds " + num(at(c, "holds_where"));
-    std::string prediction = num(at(c, "prediction"));
-    if (c.contains("matches_prediction") && c["matches_prediction"].is_boolean()) {
-      prediction += c["matches_prediction"].get<bool>() ? " (agrees)" : " (differs)";
+// "value comparison threshold unit (law: prediction, agrees)" in one cell
+std::string measured_cell(const Json& c, const Json& side) {
+  std::string v = num(at(side, "value")) + " " + num(at(c, "comparison")) +
+                  " " + num(at(c, "threshold"));
+  const Json& unit = at(c, "unit");
+  if (unit.is_string() && !unit.get<std::string>().empty()) v += " " + num(unit);
+  if (!at(side, "prediction").is_null()) {
+    v += " (law: " + num(at(side, "prediction"));
+    const Json& m = at(side, "matches_prediction");
+    if (m.is_boolean()) v += m.get<bool>() ? ", agrees" : ", differs";
+    v += ")";
+  }
+  return v;
+}
+
+// the verdict: pass, FAIL, or partial naming the sides where it fails
+std::string verdict_text(const Json& c) {
+  const Json& verdict = at(c, "pass");
+  if (verdict.is_boolean()) return verdict.get<bool>() ? "pass" : "FAIL";
+  std::string failing;
+  for (const Json& side : at(c, "sides")) {
+    const Json& p = at(side, "pass");
+    if (p.is_boolean() && !p.get<bool>()) {
+      failing += (failing.empty() ? "" : "; ") + num(at(side, "where"));
     }
-    s += std::string(pass || partial ? "<tr>" : "<tr class=\"fail\">") +
-         td(num(at(c, "name"))) + td(num(at(c, "value"))) +
-         td(num(at(c, "comparison"))) + td(num(at(c, "threshold"))) +
-         td(num(at(c, "unit"))) +
-         td(verdict_text, pass ? "pass" : partial ? "partial" : "fail") +
-         td(prediction) + td(num(at(c, "regime"))) +
-         td(num(at(c, "window"))) + td(num(at(c, "mean_path_distance_mm"))) +
-         td(num(at(c, "statement"))) + "</tr>\n";
+  }
+  return "partial: fails " + (failing.empty() ? std::string("on a side") : failing);
+}
+
+std::string verdict_class(const Json& c) {
+  const Json& verdict = at(c, "pass");
+  if (verdict.is_boolean()) return verdict.get<bool>() ? "pass" : "fail";
+  return "partial";
+}
+
+std::string claim_anchor(const std::string& case_name, const Json& c) {
+  return case_name + "-claim-" + num(at(c, "name"));
+}
+
+std::string claims_table(const std::string& case_name, const Json& summary) {
+  std::string s = "<table class=\"claims\">\n<tr>" + th("claim") +
+                  th("what the thesis says") + th("verdict") +
+                  th("measured vs threshold (law's prediction)") +
+                  th("each side: measured (prediction), verdict") +
+                  th("regime") + th("window") + "</tr>\n";
+  for (const Json& c : at(summary, "claims")) {
+    const std::string cls = verdict_class(c);
+    std::string sides;
+    for (const Json& side : at(c, "sides")) {
+      const Json& p = at(side, "pass");
+      const bool ok = p.is_boolean() && p.get<bool>();
+      sides += "<li" + std::string(ok ? "" : " class=\"fail\"") + ">" +
+               escape(num(at(side, "where")) + ": " + measured_cell(c, side) +
+                      (ok ? ", holds" : ", FAILS")) +
+               "</li>";
+    }
+    s += std::string(cls == "fail" ? "<tr class=\"fail\"" : "<tr") + " id=\"" +
+         escape(claim_anchor(case_name, c)) + "\">" + td(num(at(c, "name"))) +
+         td(num(at(c, "statement"))) + td(verdict_text(c), cls) +
+         td(measured_cell(c, c)) +
+         "<td>" + (sides.empty() ? std::string("one side") : "<ul class=\"sides\">" + sides + "</ul>") +
+         "</td>" + td(num(at(c, "regime"))) + td(num(at(c, "window"))) + "</tr>\n";
   }
   return s + "</table>\n";
 }
@@ -171,14 +223,22 @@ std::string case_section(const ReportCase& c) {
                       num(at(m, "max_force_N")) + " N); scene " +
                       num(at(c.summary, "scene"))) + "</p>\n";
   s += "<h3>Parameters</h3>\n" + parameters(c.summary);
-  s += "<h3>Claims</h3>\n" + claims_table(c.summary);
+  s += "<h3>Claims</h3>\n" + claims_table(c.name, c.summary);
   s += "<h3>Figures</h3>\n";
   s += figure(c.force_field_svg,
               c.name + ": the commanded force along the RM wrist-centre "
-              "trajectory (device frame, mm)");
+              "trajectory (device frame, mm)",
+              c.name + "-force-field", c.name + "/force_field.svg");
+  s += figure(c.thesis_svg,
+              c.name + ": theta_V and theta_R against time, and the RM "
+              "wrist centre's trajectory in the mechanism's plane coloured by "
+              "time (the thesis's figures)",
+              c.name + "-thesis", c.name + "/thesis.svg");
   s += figure(c.views_svg, c.name + ": the RM off the path and on it "
-                           "(device frame, mm)");
-  s += figure(c.history_svg, c.name + ": error and force against time");
+                           "(device frame, mm)",
+              c.name + "-views", c.name + "/views.svg");
+  s += figure(c.history_svg, c.name + ": error and force against time",
+              c.name + "-history", c.name + "/history.svg");
   s += "<figure>\n";
   if (c.render_png) {
     s += "<img alt=\"" + escape(c.name) + " render\" src=\"data:image/png;base64," +
@@ -196,7 +256,7 @@ std::string run_time_table(const std::vector<ReportCase>& cases) {
   std::string s = "<table class=\"runtime\">\n<tr>" + th("case") +
                   th("simulated_s") + th("wall_time_s") +
                   th("realtime_factor") + th("rms_path_error_mm") +
-                  th("max_path_error_mm") + th("rms_xv_error_mm") +
+                  th("max_path_error_mm") + th("mean_force_N") +
                   th("claims passed") + "</tr>\n";
   for (const ReportCase& c : cases) {
     const Json& m = at(c.summary, "metrics");
@@ -212,15 +272,39 @@ std::string run_time_table(const std::vector<ReportCase>& cases) {
          td(num(at(c.summary, "realtime_factor"))) +
          td(num(at(m, "rms_path_error_mm"))) +
          td(num(at(m, "max_path_error_mm"))) +
-         td(num(at(m, "rms_xv_error_mm"))) +
+         td(num(at(m, "mean_force_N"))) +
          td(std::to_string(pass) + "/" + std::to_string(total)) + "</tr>\n";
   }
   return s + "</table>\n";
 }
 
+// what "pass" says for a scenario with this outcome
+std::string pass_means(const std::string& outcome) {
+  if (outcome == "ok") {
+    return "finite, force and torques within their limits, energy bounded "
+           "at rest, the expected status seen";
+  }
+  if (outcome == "limit_cycle") {
+    return "finite and within the limits; the energy pumped in at rest is a "
+           "known, documented limit cycle of this gain, not a fault: the "
+           "device is not passive here";
+  }
+  if (outcome.rfind("fault_detected", 0) == 0) {
+    return "the injected fault was detected (" + outcome.substr(15) +
+           ") and the torque zeroed";
+  }
+  if (outcome.rfind("fault_undetected", 0) == 0) {
+    return "a fault the device layer is known not to see (" +
+           outcome.substr(17) + "): the run stayed finite and within the "
+           "limits, nothing more; a documented blind spot, not a safety claim";
+  }
+  return "failed: " + outcome;
+}
+
 std::string extremes_table(const Json& ex) {
   std::string s = "<table class=\"extremes\">\n<tr>" + th("scenario") +
                   th("stresses") + th("outcome") + th("pass") +
+                  th("what pass means here") +
                   th("max_force_N") + th("force_limit_N") +
                   th("energy motor_max_J") + th("energy rest_rise_J") +
                   th("wall_time_s") + "</tr>\n";
@@ -231,6 +315,7 @@ std::string extremes_table(const Json& ex) {
          td(num(at(r, "name"))) + td(num(at(r, "stresses"))) +
          td(num(at(r, "outcome"))) +
          td(pass ? "pass" : "FAIL", pass ? "pass" : "fail") +
+         td(pass_means(num(at(r, "outcome")))) +
          td(num(at(r, "max_force_N"))) + td(num(at(r, "force_limit_N"))) +
          td(num(at(e, "motor_max_J"))) + td(num(at(e, "rest_rise_J"))) +
          td(num(at(r, "wall_time_s"))) + "</tr>\n";
@@ -272,8 +357,9 @@ ReportCase load_report_case(const std::string& dir, const std::string& name,
                              ": the VM's parameters: " + e.what());
   }
   try {
-    c.force_field_svg = force_field_svg(
-        force_samples_from_csv(read_text(d / "trace.csv")), path);
+    const std::string trace = read_text(d / "trace.csv");
+    c.force_field_svg = force_field_svg(force_samples_from_csv(trace), path);
+    c.thesis_svg = thesis_svg(thesis_samples_from_csv(trace), path);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error((d / "trace.csv").string() + ": " + e.what());
   }
@@ -337,9 +423,73 @@ std::string base64(const std::string& bytes) {
   return out;
 }
 
-std::string inline_svg(const std::string& svg_document) {
+std::string inline_svg(const std::string& svg_document,
+                       const std::string& id_prefix) {
   const std::size_t start = svg_document.find("<svg");
-  return start == std::string::npos ? std::string() : svg_document.substr(start);
+  if (start == std::string::npos) return std::string();
+  const std::string svg = svg_document.substr(start);
+  if (id_prefix.empty()) return svg;
+  // the three forms the project's SVG writers use: an attribute id="x"
+  // (after white space, so that data-id= and the like are left alone), a
+  // paint or clip reference url(#x), and a link href="#x" / xlink:href="#x"
+  std::string out;
+  out.reserve(svg.size() + svg.size() / 20);
+  std::size_t i = 0;
+  while (i < svg.size()) {
+    std::size_t skip = 0;
+    if ((svg[i] == ' ' || svg[i] == '\n' || svg[i] == '\t') &&
+        svg.compare(i + 1, 4, "id=\"") == 0) {
+      skip = 5;
+    } else if (svg.compare(i, 5, "url(#") == 0) {
+      skip = 5;
+    } else if (svg.compare(i, 7, "href=\"#") == 0) {
+      skip = 7;
+    }
+    if (skip == 0) {
+      out += svg[i++];
+      continue;
+    }
+    out.append(svg, i, skip);
+    out += id_prefix;
+    i += skip;
+  }
+  return out;
+}
+
+// rows: every claim (in the order first met), columns: the cases; a cell
+// is the claim's verdict in that case, linked to its row, or blank where
+// the case does not make that claim
+std::string claim_matrix(const std::vector<ReportCase>& cases) {
+  std::vector<std::string> names;
+  for (const ReportCase& c : cases) {
+    for (const Json& k : at(c.summary, "claims")) {
+      const std::string n = num(at(k, "name"));
+      if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+    }
+  }
+  std::string s = "<table class=\"matrix\">\n<tr>" + th("claim");
+  for (const ReportCase& c : cases) {
+    s += "<th><a href=\"#" + escape(c.name) + "\">" + escape(c.name) + "</a></th>";
+  }
+  s += "</tr>\n";
+  for (const std::string& n : names) {
+    s += "<tr>" + td(n);
+    for (const ReportCase& c : cases) {
+      const Json* claim = nullptr;
+      for (const Json& k : at(c.summary, "claims")) {
+        if (num(at(k, "name")) == n) claim = &k;
+      }
+      if (claim == nullptr) {
+        s += "<td class=\"none\"></td>";
+        continue;
+      }
+      s += "<td class=\"" + verdict_class(*claim) + "\"><a href=\"#" +
+           escape(claim_anchor(c.name, *claim)) + "\">" +
+           escape(verdict_text(*claim)) + "</a></td>";
+    }
+    s += "</tr>\n";
+  }
+  return s + "</table>\n";
 }
 
 std::string report_html(const ReportInputs& in) {
@@ -353,16 +503,6 @@ std::string report_html(const ReportInputs& in) {
       std::string(kStyle) + "</style>\n</head>\n<body>\n";
   s += "<h1>vmhaptics: virtual-mechanism control of the PHANTOM Omni, the "
        "thesis's cases measured</h1>\n";
-  s += "<table class=\"header\">\n";
-  s += "<tr>" + th("software") + td("vmhaptics " + h.version) + "</tr>\n";
-  s += "<tr>" + th("git describe (at configure time)") + td(h.git_describe) + "</tr>\n";
-  s += "<tr>" + th("generated (UTC)") + td(h.generated_utc) + "</tr>\n";
-  s += "<tr>" + th("command line") + td(h.command_line) + "</tr>\n";
-  s += "<tr>" + th("cores") + td(std::to_string(h.cores)) + "</tr>\n";
-  s += "<tr>" + th("wall time (s)") + td(num(Json(h.wall_s))) + "</tr>\n";
-  s += "<tr>" + th("ran") + td(list_text(h.ran)) + "</tr>\n";
-  s += "<tr>" + th("reused from disk") + td(list_text(h.reused)) + "</tr>\n";
-  s += "</table>\n";
   s += std::string("<p id=\"summary\" class=\"summary\">Claims passed: ") +
        "<span class=\"" + (all_pass ? "pass" : "fail") + "\">" +
        std::to_string(tally.passed) + "/" + std::to_string(tally.total) +
@@ -372,30 +512,42 @@ std::string report_html(const ReportInputs& in) {
                        escape(list_text(tally.failed)) + "</span>") +
        (tally.partial.empty()
             ? std::string()
-            : " &#8212; holding in part (each one's holds_where says where): " +
-                  escape(list_text(tally.partial))) +
+            : " &#8212; holding on some sides only (the cell names the side "
+              "where it fails): " + escape(list_text(tally.partial))) +
        "</p>\n";
-  s += "<ul>\n";
+  s += "<section id=\"matrix\">\n<h2>Which claims hold, in which case</h2>\n" +
+       claim_matrix(in.cases) +
+       "<p class=\"legend\">pass: holds on every side it is measured on; "
+       "partial: holds on some, the cell names where it fails; FAIL: fails "
+       "on every side; blank: the case makes no such claim. Each cell links "
+       "to the claim's row with every side's value.</p>\n</section>\n";
+  s += "<section id=\"runtime\">\n<h2>Accuracy and run time, per case</h2>\n" +
+       run_time_table(in.cases) +
+       "<p class=\"legend\">rms and max path error: the RM wrist centre's "
+       "distance from the VM's path after the first second (mm); mean_force_N: "
+       "the commanded |F|; realtime_factor: simulated over wall seconds on "
+       "this machine.</p>\n</section>\n";
+  s += "<ul class=\"contents\">\n";
   for (const ReportCase& c : in.cases) {
     s += "<li><a href=\"#" + escape(c.name) + "\">" + escape(c.name) + "</a></li>\n";
   }
-  s += "<li><a href=\"#runtime\">error against run time</a></li>\n"
-       "<li><a href=\"#precision\">work-precision</a></li>\n"
+  s += "<li><a href=\"#precision\">work-precision</a></li>\n"
        "<li><a href=\"#stability\">stability map</a></li>\n"
-       "<li><a href=\"#extremes\">extreme scenarios</a></li>\n</ul>\n";
+       "<li><a href=\"#extremes\">extreme scenarios</a></li>\n"
+       "<li><a href=\"#about\">how this page was made</a></li>\n</ul>\n";
 
   for (const ReportCase& c : in.cases) s += case_section(c);
 
   const ReportStudies& st = in.studies;
-  s += "<section id=\"runtime\">\n<h2>Error against run time, per case</h2>\n" +
-       run_time_table(in.cases) + "</section>\n";
   s += "<section id=\"precision\">\n<h2>Work-precision (" +
        escape(st.precision_case.empty() ? "not run" : st.precision_case) +
        ")</h2>\n";
   s += figure(st.precision_svg, "trajectory error (RMS, mm) against wall "
-                                "time (s), per integrator and physics step");
+                                "time (s), per integrator and physics step",
+              "precision", "study/precision.svg");
   s += figure(st.precision_order_svg, "trajectory error against the physics "
-                                      "step h, with the fitted orders");
+                                      "step h, with the fitted orders",
+              "precision-order", "study/precision_order.svg");
   if (!st.precision_csv.empty()) {
     s += "<details><summary>every run (precision.csv)</summary>\n" +
          csv_table(st.precision_csv, "precision") + "</details>\n";
@@ -404,7 +556,8 @@ std::string report_html(const ReportInputs& in) {
   s += "<section id=\"stability\">\n<h2>Stability map of the sampled-data "
        "wall</h2>\n<p>" + escape(st.stability_note) + "</p>\n";
   s += figure(st.stability_map_svg, "K_crit (N/m) against the virtual "
-                                    "damping B (N s/m), per delay");
+                                    "damping B (N s/m), per delay",
+              "stability-map", "study/stability_map.svg");
   if (!st.stability_map_csv.empty()) {
     s += "<details><summary>the map (stability_map.csv)</summary>\n" +
          csv_table(st.stability_map_csv, "stability") + "</details>\n";
@@ -416,8 +569,20 @@ std::string report_html(const ReportInputs& in) {
   } else {
     s += extremes_table(st.extremes);
   }
-  s += figure(st.extremes_svg, "the passivity observer's energy per scenario (mJ)");
+  s += figure(st.extremes_svg, "the passivity observer's energy per scenario (mJ)",
+              "extremes", "study/extremes.svg");
   s += "</section>\n";
+  s += "<section id=\"about\">\n<h2>How this page was made</h2>\n";
+  s += "<table class=\"header\">\n";
+  s += "<tr>" + th("software") + td("vmhaptics " + h.version) + "</tr>\n";
+  s += "<tr>" + th("git describe (at configure time)") + td(h.git_describe) + "</tr>\n";
+  s += "<tr>" + th("generated (UTC)") + td(h.generated_utc) + "</tr>\n";
+  s += "<tr>" + th("command line") + td(h.command_line) + "</tr>\n";
+  s += "<tr>" + th("cores") + td(std::to_string(h.cores)) + "</tr>\n";
+  s += "<tr>" + th("wall time (s)") + td(num(Json(h.wall_s))) + "</tr>\n";
+  s += "<tr>" + th("ran") + td(list_text(h.ran)) + "</tr>\n";
+  s += "<tr>" + th("reused from disk") + td(list_text(h.reused)) + "</tr>\n";
+  s += "</table>\n</section>\n";
   s += "<p class=\"summary\">Claims passed: " + std::to_string(tally.passed) +
        "/" + std::to_string(tally.total) + "</p>\n</body>\n</html>\n";
   return s;

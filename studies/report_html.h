@@ -41,6 +41,7 @@ struct ReportCase {
   std::string name;
   nlohmann::json summary;  // summary.json
   std::string force_field_svg, views_svg, history_svg;
+  std::string thesis_svg;  // theta_V, theta_R against time; the trajectory
   std::optional<std::string> render_png;  // PNG bytes
   std::string render_note;                // why there is no render
 };
@@ -91,8 +92,13 @@ std::string report_html(const ReportInputs& in);
 std::string base64(const std::string& bytes);
 
 // An SVG document ready to sit inside HTML: any XML prolog or DOCTYPE before
-// the <svg> element dropped.
-std::string inline_svg(const std::string& svg_document);
+// the <svg> element dropped, and, with a non-empty `id_prefix`, every id it
+// defines and every reference to one (url(#x), href="#x") prefixed, so that
+// figures inlined in one page cannot share an id. (Two figures that each
+// define id="plot-clip" would otherwise both be clipped by the first
+// definition's rectangle, and lose points: issue 31.)
+std::string inline_svg(const std::string& svg_document,
+                       const std::string& id_prefix = "");
 
 }  // namespace vmh::studies
 

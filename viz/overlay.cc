@@ -12,6 +12,8 @@ constexpr std::array<float, 4> kVRgba{0.90f, 0.15f, 0.15f, 1.0f};
 constexpr std::array<float, 4> kRRgba{0.15f, 0.75f, 0.20f, 1.0f};
 constexpr std::array<float, 4> kStylusRgba{0.95f, 0.85f, 0.10f, 1.0f};
 constexpr std::array<float, 4> kForceRgba{0.85f, 0.10f, 0.85f, 1.0f};
+constexpr std::array<float, 4> kHandRgba{0.96f, 0.72f, 0.58f, 0.45f};
+constexpr std::array<float, 4> kSpringRgba{0.62f, 0.36f, 0.12f, 1.0f};
 
 // a point in the controller's length unit, device frame -> world m
 struct ToWorld {
@@ -124,6 +126,8 @@ const char* overlay_name(OverlayId id) {
     case OverlayId::kPointR: return "x_r";
     case OverlayId::kStylus: return "stylus";
     case OverlayId::kForce: return "force";
+    case OverlayId::kHandTarget: return "hand_target";
+    case OverlayId::kHandSpring: return "hand_spring";
   }
   return "?";
 }
@@ -159,14 +163,51 @@ void overlay_primitives(const VirtualMechanism& vm,
   }
 }
 
+void hand_primitives(const Vec3& target_m, const Mat3& target_R,
+                     const Vec3& grip_m, std::vector<OverlayPrimitive>* prims) {
+  if (!target_m.allFinite() || !target_R.allFinite() || !grip_m.allFinite()) {
+    return;
+  }
+  // a thumb's and an index finger's pads, 11 mm either side of the pen axis
+  // the target asks for, each 24 mm along it: a pen grip, seen through
+  const Vec3 along = target_R.col(2).normalized();
+  const Vec3 side = target_R.col(0).normalized();
+  for (double s : {-1.0, 1.0}) {
+    const Vec3 c = target_m + s * 0.011 * side;
+    prims->push_back(segment(OverlayId::kHandTarget, c - 0.012 * along,
+                             c + 0.012 * along, 0.0065, kHandRgba));
+  }
+  // the spring from the target to the grip: eight coils of a zig-zag
+  // 3 mm to either side of the line
+  const Vec3 d = grip_m - target_m;
+  const double len = d.norm();
+  if (len < 5e-4) return;
+  const Vec3 u = d / len;
+  Vec3 n = u.cross(side);
+  if (n.norm() < 1e-6) n = u.cross(Vec3::UnitZ());
+  if (n.norm() < 1e-6) n = u.cross(Vec3::UnitX());
+  n.normalize();
+  constexpr int kPoints = 17;
+  Vec3 prev = target_m;
+  for (int i = 1; i <= kPoints; ++i) {
+    const double f = static_cast<double>(i) / (kPoints + 1);
+    const Vec3 next = target_m + f * d + (i % 2 == 0 ? 1.0 : -1.0) * 0.003 * n;
+    prims->push_back(
+        segment(OverlayId::kHandSpring, prev, next, 0.0006, kSpringRgba));
+    prev = next;
+  }
+  prims->push_back(
+      segment(OverlayId::kHandSpring, prev, grip_m, 0.0006, kSpringRgba));
+}
+
 int add_overlay_to_scene(const std::vector<OverlayPrimitive>& prims,
                          mjvScene* scn, float model_alpha) {
   if (!prims.empty() && model_alpha < 1.0f) {
     const float a = model_alpha < 0.0f ? 0.0f : model_alpha;
     for (int i = 0; i < scn->ngeom; ++i) {
       mjvGeom* g = scn->geoms + i;
-      if (g->category == mjCAT_DECOR) continue;
-      g->rgba[3] *= a;
+      if (g->category != mjCAT_DYNAMIC) continue;
+      if (g->rgba[3] > a) g->rgba[3] = a;
       g->transparent = 1;
     }
   }
@@ -190,6 +231,7 @@ int add_overlay_to_scene(const std::vector<OverlayPrimitive>& prims,
                         p.b_m.x(), p.b_m.y(), p.b_m.z());
     }
     g->category = mjCAT_DECOR;
+    g->transparent = rgba[3] < 1.0f ? 1 : 0;
     g->objtype = mjOBJ_UNKNOWN;
     g->objid = -1;
     scn->ngeom++;

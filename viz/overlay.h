@@ -22,7 +22,13 @@
 //   kStylus      the stylus axis through the wrist centre p, yellow;
 //   kForce       the commanded force F (after saturation) as an arrow from p,
 //                force_m_per_N x |F| long, magenta; left out when |F| is
-//                below min_force_N.
+//                below min_force_N;
+//   kHandTarget  the simulated hand's target (the mocap body hand_target,
+//                sim/hand.h): two translucent fingertip pads either side of
+//                the pen axis the target asks for, skin-coloured;
+//   kHandSpring  the hand's coupling, target to the stylus's grip site, as
+//                a zig-zag spring line, brown: who pushes the stylus, and
+//                where to (hand_primitives(), drawn in every case).
 #ifndef VMHAPTICS_VIZ_OVERLAY_H_
 #define VMHAPTICS_VIZ_OVERLAY_H_
 
@@ -44,6 +50,8 @@ enum class OverlayId {
   kPointR,
   kStylus,
   kForce,
+  kHandTarget,
+  kHandSpring,
 };
 
 // a name for each id ("path", "link_v", ...), for tests and screenshots
@@ -85,15 +93,23 @@ void overlay_primitives(const VirtualMechanism& vm,
                         const ControlOutput& out, const OverlayOptions& opt,
                         std::vector<OverlayPrimitive>* prims);
 
+// The simulated hand: its target pose (world frame, m; R's columns the
+// target frame's axes, z along the pen) and the grip site it pulls toward
+// it. Appends the kHandTarget pads and, when the two are more than 0.5 mm
+// apart, the kHandSpring zig-zag to *prims (not cleared).
+void hand_primitives(const Vec3& target_m, const Mat3& target_R,
+                     const Vec3& grip_m, std::vector<OverlayPrimitive>* prims);
+
 // Adds the primitives to the scene as mjvGeoms (lines and arrows as MuJoCo
-// connectors, points as spheres), after what mjv_updateScene put there.
-// The model's own geoms already in the scene are first made translucent
-// (their alpha times `model_alpha`, in [0, 1]; 1 leaves them alone): the
-// links, X(theta_V) and the force arrow mostly run inside the gimbal and
-// the stylus, where opaque bodies would hide them. Nothing is faded when
-// there are no primitives. Stops when the scene is full; returns how many
-// were added.
-inline constexpr float kOverlayModelAlpha = 0.35f;
+// connectors, points as spheres), after what mjv_updateScene put there; a
+// primitive with alpha below 1 is drawn as transparent. The moving bodies
+// already in the scene (category mjCAT_DYNAMIC: the device's links, not
+// the desk or the base) are first given an alpha of at most `model_alpha`
+// (in [0, 1]; 1 leaves them alone): X(theta_V) and the force arrow start
+// at the wrist centre, inside the gimbal, and a slightly translucent device
+// shows them while it stays plainly solid. Nothing is faded when there are
+// no primitives. Stops when the scene is full; returns how many were added.
+inline constexpr float kOverlayModelAlpha = 0.8f;
 int add_overlay_to_scene(const std::vector<OverlayPrimitive>& prims,
                          mjvScene* scn,
                          float model_alpha = kOverlayModelAlpha);

@@ -1,6 +1,7 @@
 #include "viz/scene_renderer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "controller/device_frame.h"
@@ -41,6 +42,81 @@ mjvCamera workspace_camera(const OmniParams& omni) {
   return cam;
 }
 
+mjvCamera default_camera(const mjModel* m, const OmniParams& omni) {
+  const int id = mj_name2id(m, mjOBJ_CAMERA, "three_quarter");
+  if (id < 0) return workspace_camera(omni);
+  mjvCamera cam;
+  mjv_defaultCamera(&cam);
+  cam.type = mjCAMERA_FIXED;
+  cam.fixedcamid = id;
+  return cam;
+}
+
+mjvCamera free_camera_like(const mjModel* m, int cam_id) {
+  mjvCamera cam;
+  mjv_defaultFreeCamera(m, &cam);
+  if (cam_id < 0 || cam_id >= m->ncam) return cam;
+  mjtNum R[9];
+  mju_quat2Mat(R, m->cam_quat + 4 * cam_id);
+  const mjtNum* p = m->cam_pos + 3 * cam_id;
+  // a camera looks along its -z axis
+  const Vec3 f(-R[2], -R[5], -R[8]);
+  const Vec3 eye(p[0], p[1], p[2]);
+  const Vec3 centre(m->stat.center[0], m->stat.center[1], m->stat.center[2]);
+  double depth = (centre - eye).dot(f);
+  if (!(depth > 1e-3)) depth = 0.5;
+  const double deg = 3.14159265358979323846 / 180.0;
+  const double scale = std::tan(0.5 * m->cam_fovy[cam_id] * deg) /
+                       std::tan(0.5 * m->vis.global.fovy * deg);
+  const Vec3 lookat = eye + depth * f;
+  for (int i = 0; i < 3; ++i) cam.lookat[i] = lookat[i];
+  cam.distance = depth * scale;
+  cam.azimuth = std::atan2(f.y(), f.x()) / deg;
+  cam.elevation = std::asin(std::clamp(f.z(), -1.0, 1.0)) / deg;
+  return cam;
+}
+
+std::vector<std::string> camera_names(const mjModel* m) {
+  std::vector<std::string> names;
+  for (int i = 0; i < m->ncam; ++i) {
+    const char* n = mj_id2name(m, mjOBJ_CAMERA, i);
+    names.push_back(n != nullptr ? std::string(n) : "#" + std::to_string(i));
+  }
+  return names;
+}
+
+void prepare_scene(const mjModel* m, mjData* d, const mjvOption* opt,
+                   mjvCamera* cam, const std::vector<OverlayPrimitive>& overlay,
+                   mjvScene* scn) {
+  mjv_updateScene(m, d, opt, nullptr, cam, mjCAT_ALL, scn);
+  // a scene without lights (a user's scene without models/omni/stage.xml):
+  // a brighter headlight than MuJoCo's default shows the arm's shape
+  if (m->nlight == 0 && scn->nlight > 0 && scn->lights[0].headlight) {
+    for (int i = 0; i < 3; ++i) {
+      scn->lights[0].ambient[i] = std::max(scn->lights[0].ambient[i], 0.3f);
+      scn->lights[0].diffuse[i] = std::max(scn->lights[0].diffuse[i], 0.7f);
+    }
+  }
+  add_overlay_to_scene(overlay, scn);
+  const int body = mj_name2id(m, mjOBJ_BODY, "hand_target");
+  const int grip = mj_name2id(m, mjOBJ_SITE, "grip");
+  const int mocap = body >= 0 ? m->body_mocapid[body] : -1;
+  if (mocap >= 0 && grip >= 0) {
+    const mjtNum* p = d->mocap_pos + 3 * mocap;
+    mjtNum R[9];
+    mju_quat2Mat(R, d->mocap_quat + 4 * mocap);
+    Mat3 target_R;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) target_R(r, c) = R[3 * r + c];
+    }
+    const mjtNum* g = d->site_xpos + 3 * grip;
+    std::vector<OverlayPrimitive> hand;
+    hand_primitives(Vec3(p[0], p[1], p[2]), target_R, Vec3(g[0], g[1], g[2]),
+                    &hand);
+    add_overlay_to_scene(hand, scn, 1.0f);
+  }
+}
+
 int camera_id(const mjModel* m, const std::string& name) {
   const int id = mj_name2id(m, mjOBJ_CAMERA, name.c_str());
   if (id >= 0) return id;
@@ -59,7 +135,7 @@ int camera_id(const mjModel* m, const std::string& name) {
 
 SceneRenderer::SceneRenderer(const mjModel* m, const OmniParams& omni,
                              int max_width_px, int max_height_px)
-    : m_(m), free_cam_(workspace_camera(omni)) {
+    : m_(m), free_cam_(default_camera(m, omni)) {
   check_size("width", max_width_px);
   check_size("height", max_height_px);
   mjv_defaultScene(&scn_);
@@ -114,16 +190,7 @@ std::vector<std::uint8_t> SceneRenderer::render_rgb(
     cam.type = mjCAMERA_FIXED;
     cam.fixedcamid = camera_id(m, camera);
   }
-  mjv_updateScene(m, d, &opt_, nullptr, &cam, mjCAT_ALL, &scn_);
-  // the case scenes have no lights of their own (models/cases/*.xml):
-  // a brighter headlight than MuJoCo's default shows the arm's shape
-  if (scn_.nlight > 0 && scn_.lights[0].headlight) {
-    for (int i = 0; i < 3; ++i) {
-      scn_.lights[0].ambient[i] = std::max(scn_.lights[0].ambient[i], 0.3f);
-      scn_.lights[0].diffuse[i] = std::max(scn_.lights[0].diffuse[i], 0.7f);
-    }
-  }
-  add_overlay_to_scene(overlay, &scn_);
+  prepare_scene(m, d, &opt_, &cam, overlay, &scn_);
 
   mjr_setBuffer(mjFB_OFFSCREEN, &con_);
   const mjrRect viewport{0, 0, width_px, height_px};
@@ -137,6 +204,43 @@ std::vector<std::uint8_t> SceneRenderer::render_rgb(
   mjr_readPixels(rgb.data(), nullptr, viewport, &con_);
   flip_rows(width_px, height_px, &rgb);
   return rgb;
+}
+
+std::vector<int> SceneRenderer::render_geom_ids(const mjModel* m, mjData* d,
+                                                int width_px, int height_px,
+                                                const std::string& camera) {
+  // the colour of segid s is s + 1 in (r, g, b) = (low, middle, high) byte
+  scn_.flags[mjRND_SEGMENT] = 1;
+  scn_.flags[mjRND_IDCOLOR] = 1;
+  std::vector<std::uint8_t> rgb;
+  try {
+    rgb = render_rgb(m, d, {}, width_px, height_px, camera);
+  } catch (...) {
+    scn_.flags[mjRND_SEGMENT] = 0;
+    scn_.flags[mjRND_IDCOLOR] = 0;
+    throw;
+  }
+  scn_.flags[mjRND_SEGMENT] = 0;
+  scn_.flags[mjRND_IDCOLOR] = 0;
+  std::vector<int> ids(static_cast<std::size_t>(width_px) *
+                       static_cast<std::size_t>(height_px), -1);
+  // segid -> the model geom drawn with it
+  std::vector<int> geom_of_seg;
+  for (int k = 0; k < scn_.ngeom; ++k) {
+    const mjvGeom& g = scn_.geoms[k];
+    if (g.segid < 0 || g.objtype != mjOBJ_GEOM) continue;
+    if (static_cast<std::size_t>(g.segid) >= geom_of_seg.size()) {
+      geom_of_seg.resize(static_cast<std::size_t>(g.segid) + 1, -1);
+    }
+    geom_of_seg[static_cast<std::size_t>(g.segid)] = g.objid;
+  }
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const int seg = rgb[3 * i] + 256 * rgb[3 * i + 1] + 65536 * rgb[3 * i + 2] - 1;
+    if (seg >= 0 && static_cast<std::size_t>(seg) < geom_of_seg.size()) {
+      ids[i] = geom_of_seg[static_cast<std::size_t>(seg)];
+    }
+  }
+  return ids;
 }
 
 }  // namespace vmh::viz

@@ -28,6 +28,34 @@ namespace vmh::viz {
 // is seen nearly face on and the arm beside it.
 mjvCamera workspace_camera(const OmniParams& omni);
 
+// The view a frame starts from when no camera is named: the model's camera
+// "three_quarter" (models/omni/stage.xml) when it has one, looking the same
+// as `--camera three_quarter`, else workspace_camera() as a free camera.
+mjvCamera default_camera(const mjModel* m, const OmniParams& omni);
+
+// A free camera showing what the model's camera `cam_id` (a world-fixed
+// camera) shows: looking the same way at the point of its line of sight
+// nearest the model's centre (statistic center), from a distance scaled so
+// that, at the free camera's field of view (visual/global fovy), the frame
+// holds the same. The viewer starts from it and its camera key steps
+// through them, keeping the free camera the mouse turns and the mouse hand
+// reads (viz/mouse_hand.h).
+mjvCamera free_camera_like(const mjModel* m, int cam_id);
+
+// the model's cameras' names, in the model's order (unnamed ones as "#i")
+std::vector<std::string> camera_names(const mjModel* m);
+
+// What `vmhaptics render` and `vmhaptics view` draw, made in one place so
+// that the two show the same scene: MuJoCo's scene of `d` seen from `cam`,
+// a brighter headlight for a scene without lights of its own, the overlay
+// (viz/overlay.h; the moving bodies at kOverlayModelAlpha while there is
+// one) and the simulated hand (its target's pads and its spring to the
+// grip site, hand_primitives(), whenever the model has the mocap body
+// "hand_target" and the site "grip"). Fills *scn.
+void prepare_scene(const mjModel* m, mjData* d, const mjvOption* opt,
+                   mjvCamera* cam, const std::vector<OverlayPrimitive>& overlay,
+                   mjvScene* scn);
+
 // The id of the model's camera called `name`. Throws std::invalid_argument
 // naming the camera and listing the model's cameras when there is none by
 // that name.
@@ -56,7 +84,7 @@ class SceneRenderer {
 
   // Renders `d`'s state of the renderer's model with `overlay` added,
   // width_px x height_px (within the buffer's size), seen from the model's
-  // camera `camera` or, when empty, from workspace_camera(). Returns
+  // camera `camera` or, when empty, from default_camera(). Returns
   // 3 * width * height bytes of RGB, rows from the top. Throws
   // std::invalid_argument on a size larger than the buffer or an unknown
   // camera.
@@ -64,6 +92,14 @@ class SceneRenderer {
       const mjModel* m, mjData* d, const std::vector<OverlayPrimitive>& overlay,
       int width_px, int height_px, const std::string& camera,
       const RenderLabel& label = {});
+
+  // Which of the model's geoms each pixel shows, as render_rgb would draw
+  // the state without overlay (MuJoCo's segmentation rendering): the geom
+  // id, or -1 for the background, a decoration or the hand. Rows from the
+  // top, width_px * height_px entries. For measuring what a camera frames
+  // (tests/viz/render_test.cc, the device's share of each camera's frame).
+  std::vector<int> render_geom_ids(const mjModel* m, mjData* d, int width_px,
+                                   int height_px, const std::string& camera);
 
   // The last frame's scene: its camera (scene().camera[0]) says how world
   // points project to pixels.

@@ -14,6 +14,7 @@
 #include "controller/device_frame.h"
 #include "sim/closed_loop.h"
 #include "viz/png.h"
+#include "viz/scene_renderer.h"
 #include "viz/viewer_hud.h"
 #include "viz/viewer_physics.h"
 #include "viz/viewer_window.h"
@@ -52,15 +53,33 @@ Viewer::Viewer(const ViewerOptions& options)
   static_assert(kPlotSamples == 1000, "Viewer::plots_ is sized for it");
   plots_ = std::make_unique<std::array<PlotSample, kPlotSamples>>();
   build_case();
-  mjv_defaultFreeCamera(model(), &cam_);
-  // looking at the VM's path, from far enough to see the arm that holds
-  // the stylus on it
-  const ControllerParams& p = overlay_controller_->params();
-  const Vec3 pivot_m = device_mm_to_base(p.omni, p.vm.pivot_mm);
-  for (int i = 0; i < 3; ++i) cam_.lookat[i] = pivot_m[i];
-  cam_.distance = 0.45;
-  cam_.azimuth = 150.0;
-  cam_.elevation = -25.0;
+  // the model's three-quarter view (models/omni/stage.xml) as a free
+  // camera, as `render` shows it; a scene without named cameras: the VM's
+  // path, from far enough to see the arm that holds the stylus on it
+  const std::vector<std::string> names = camera_names(model());
+  const auto it = std::find(names.begin(), names.end(), "three_quarter");
+  if (it != names.end()) {
+    set_named_camera(static_cast<int>(it - names.begin()) + 1);
+  } else {
+    mjv_defaultFreeCamera(model(), &cam_);
+    const ControllerParams& p = overlay_controller_->params();
+    const Vec3 pivot_m = device_mm_to_base(p.omni, p.vm.pivot_mm);
+    for (int i = 0; i < 3; ++i) cam_.lookat[i] = pivot_m[i];
+    cam_.distance = 0.45;
+    cam_.azimuth = 150.0;
+    cam_.elevation = -25.0;
+  }
+}
+
+void Viewer::set_named_camera(int step) {
+  const mjModel* m = model();
+  if (m->ncam == 0) return;
+  const std::vector<std::string> names = camera_names(m);
+  const auto it = std::find(names.begin(), names.end(), camera_name_);
+  const int now = it == names.end() ? -1 : static_cast<int>(it - names.begin());
+  const int next = ((now + step) % m->ncam + m->ncam) % m->ncam;
+  cam_ = free_camera_like(m, next);
+  camera_name_ = names[static_cast<std::size_t>(next)];
 }
 
 Viewer::~Viewer() {
@@ -177,18 +196,19 @@ void Viewer::render() {
   win_->framebuffer_size(&width_px_, &height_px_);
   win_height_px_ = win_->window_height_px();
   const mjrRect viewport{0, 0, width_px_, height_px_};
-  mjv_updateScene(m, d_render_, &vopt_, nullptr, &cam_, mjCAT_ALL, &scn_);
   prims_.clear();
   if (overlay_on_ && have_output_) {
     overlay_primitives(overlay_controller_->mechanism(),
                        overlay_controller_->params(), out_, OverlayOptions{},
                        &prims_);
-    add_overlay_to_scene(prims_, &scn_);
   }
+  // the scene as `render` makes it (viz/scene_renderer.h)
+  prepare_scene(m, d_render_, &vopt_, &cam_, prims_, &scn_);
   mjr_render(viewport, &scn_, &con_);
 
   HudText t;
   t.case_name = case_name();
+  t.camera = camera_name_.empty() ? "free" : camera_name_;
   t.hand = opt_.live ? opt_.live_name : (mouse_hand_ ? "mouse" : "script");
   t.k_pos_N_per_mm = overlay_controller_->params().gains.k_pos_N_per_mm;
   t.k_ornt_Nmm_per_rad = overlay_controller_->params().gains.k_ornt_Nmm_per_rad;

@@ -128,6 +128,8 @@ class Viewer {
   const mjModel* model() const;
   const mjData* frame_data() const { return d_render_; }
   const mjvCamera& camera() const { return cam_; }
+  // the model's camera the view was last set to (key c), "" for none
+  const std::string& camera_name() const { return camera_name_; }
   int viewport_width_px() const { return width_px_; }
   int viewport_height_px() const { return height_px_; }
   long frames() const { return frames_; }
@@ -167,6 +169,8 @@ class Viewer {
   int width_px_ = 0, height_px_ = 0;  // the framebuffer
   int win_height_px_ = 0;             // the window, for mouse drags
   mjvCamera cam_;
+  std::string camera_name_;
+  void set_named_camera(int step);  // the next (+1) of the model's cameras
   mjvOption vopt_;
   mjvScene scn_;
   mjrContext con_;

@@ -19,6 +19,7 @@ std::string status_text(ControlStatus s);
 // What the panel says, one line each.
 struct HudText {
   std::string case_name;
+  std::string camera;        // the named camera last chosen (key c), or "free"
   std::string hand;          // "script" or "mouse", or the device
   double k_pos_N_per_mm = 0.0;
   double k_ornt_Nmm_per_rad = 0.0;
@@ -32,6 +33,12 @@ struct HudText {
   bool paused = false;
   bool slow = false;
 };
+
+// The top of a plot's axis from zero: the smallest step * intervals >= max,
+// with step 1, 2, 2.5 or 5 times a power of ten, so that each of the
+// `intervals` grid lines falls on a round number (36.14 becomes 40 with
+// steps of 10 on 4 intervals). 1 for a max that is not a positive number.
+double round_axis_top(double max, int intervals);
 
 // The key help line (docs/viewer.md lists the same).
 const char* hud_help_text();

@@ -107,6 +107,11 @@ void Viewer::handle_key(const InputEvent& e) {
     case GLFW_KEY_O:
       overlay_on_ = !overlay_on_;
       break;
+    case GLFW_KEY_C:
+      // the model's named cameras in turn (shift: backwards), as free
+      // cameras, so that the mouse still turns the view and moves the hand
+      set_named_camera(e.shift ? -1 : 1);
+      break;
     case GLFW_KEY_P:
       want_shot_ = true;
       break;

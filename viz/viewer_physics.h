@@ -35,6 +35,7 @@ struct PlotSample {
 
 inline constexpr int kPlotSamples = 1000;     // mjMAXLINEPNT
 inline constexpr double kPlotWindow_s = 5.0;  // what the plots span
+inline constexpr int kPlotYIntervals = 2;    // grid intervals up the y axis
 inline constexpr int kMaxCatchUpTicks = 5;
 
 class SimThread {

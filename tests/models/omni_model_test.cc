@@ -147,11 +147,25 @@ TEST_F(OmniModelTest, StructureMatchesOmniParams) {
   }
   EXPECT_TRUE(omni_within_limits(params_, q_home));
   EXPECT_EQ(q_home, Joints::Zero());
-  // the model has no collision geometry (README.md): nothing can touch
+  // visual geoms (group 2) never collide; collision geoms (group 3) may
+  // touch only what a scene gives a conaffinity, so never one another: no
+  // geom of the model has a conaffinity (README.md), and every body's mass
+  // is its <inertial>, not its geoms'
+  int visual = 0, collision = 0;
   for (int g = 0; g < m->ngeom; ++g) {
-    EXPECT_EQ(m->geom_contype[g], 0) << "geom " << g;
     EXPECT_EQ(m->geom_conaffinity[g], 0) << "geom " << g;
+    if (m->geom_group[g] == 2) {
+      ++visual;
+      EXPECT_EQ(m->geom_contype[g], 0) << "geom " << g;
+    } else {
+      EXPECT_EQ(m->geom_group[g], 3) << "geom " << g;
+      EXPECT_EQ(m->geom_contype[g], 1) << "geom " << g;
+      ++collision;
+    }
   }
+  // one collision shape per moving body, and the base's
+  EXPECT_EQ(collision, m->nbody);
+  EXPECT_GT(visual, 2 * collision);
 }
 
 // Sites: "wrist" at the stylus body's origin, "grip" and "tip" 0.05 m and

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <map>
 #include <regex>
@@ -110,6 +112,35 @@ TEST(ForceFieldSvgTest, SphereHasThreeProjectionsWithTheirForces) {
     EXPECT_NE(svg.find(std::string("id=\"") + tag + "\""), std::string::npos) << tag;
   }
   expect_arrows_follow_forces(s, svg, 3);
+}
+
+// The hand holds still for 900 of 1000 rows, then moves 90 mm along x: the
+// arrows are spread along the path walked, 9 mm apart, so no more than one
+// sits where the hand held still (evenly in time, nine of ten would).
+TEST(ForceFieldSvgTest, ArrowsAreSpreadAlongThePathNotInTime) {
+  std::vector<ForceSample> s;
+  for (int i = 0; i < 1000; ++i) {
+    ForceSample f;
+    f.t_s = 0.01 * i;
+    const double x = i < 900 ? 0.0 : 0.9 * (i - 900 + 1);
+    f.p_mm = {x, 50.0, 0.0};
+    f.F_N = {0.3, -1.0, 0.0};
+    s.push_back(f);
+  }
+  const std::string svg = force_field_svg(s, {"circle", {0, 0, 0}, 50.0}, 10);
+  std::map<std::string, std::string> axes;
+  const auto arrows = arrows_of(svg, &axes);
+  ASSERT_EQ(arrows.at("xy").size(), 10u);
+  int at_rest = 0;
+  for (const Arrow& w : arrows.at("xy")) at_rest += w.t_s < 9.0 ? 1 : 0;
+  EXPECT_EQ(at_rest, 1);
+  // the arrows' tails 9 mm apart along x: equally spaced in pixels
+  std::vector<double> x;
+  for (const Arrow& w : arrows.at("xy")) x.push_back(w.x1);
+  std::sort(x.begin(), x.end());
+  for (std::size_t i = 2; i < x.size(); ++i) {
+    EXPECT_NEAR(x[i] - x[i - 1], x[1] - x[0], 0.05) << i;
+  }
 }
 
 TEST(ForceFieldSvgTest, NoRowsGivesADocumentSayingSo) {

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "sim/closed_loop.h"
 #include "tests/support/mujoco_guard.h"
 
 namespace {
@@ -89,12 +90,13 @@ TEST_F(LeannessStudy, ContactsVariantCollidesAndCarriesMoreRows) {
     const VariantResult& v = variant(name);
     EXPECT_TRUE(v.contact_enabled) << name;
     EXPECT_EQ(v.colliding_geoms, result_->cases[0].ngeom) << name;
-    // the stylus's capsule overlaps the gimbal's yaw cylinder, two bodies
-    // apart, so MuJoCo's parent filter does not drop the pair
+    // with every geom made to collide, the turret's collision cylinder
+    // overlaps the fixed drum under it (the world is not its parent for
+    // MuJoCo's filter), so contacts are found and carry constraint rows;
+    // that contact is along the turret's axis and moves nothing, so the
+    // motion itself is not compared
     EXPECT_GT(v.max_ncon, 0) << name;
     EXPECT_GT(v.mean_nefc, composed.mean_nefc) << name;
-    // and the contact pushes the stylus: the motion is not the composed one
-    EXPECT_GT(v.max_deviation_mm, 1.0) << name;
   }
 }
 
@@ -107,8 +109,18 @@ TEST_F(LeannessStudy, GravityVariantHasGravityAndItMovesTheArm) {
 
 TEST_F(LeannessStudy, RenderingFillsASceneAndChangesNothing) {
   const VariantResult& v = variant("rendering");
-  // the Omni's ten drawn geoms (groups 0-2 are visible by default)
-  EXPECT_EQ(v.scene_geoms, result_->cases[0].ngeom);
+  // the Omni's drawn geoms: groups 0-2 are visible by default, the
+  // collision class (group 3) is not
+  int visible = 0;
+  {
+    vmh::sim::ClosedLoop loop(result_->cases[0].scene, {});
+    for (int g = 0; g < loop.model()->ngeom; ++g) {
+      visible += loop.model()->geom_group[g] <= 2 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(visible, 20);
+  EXPECT_LT(visible, result_->cases[0].ngeom);
+  EXPECT_EQ(v.scene_geoms, visible);
   EXPECT_FALSE(v.contact_enabled);
   EXPECT_FALSE(v.gravity_enabled);
   EXPECT_GT(v.render_us_per_tick, 0.0);

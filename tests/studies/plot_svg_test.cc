@@ -264,8 +264,8 @@ TEST(PlotSvgTest, HistoryPolylinesAreDecimatedAndLabelled) {
     for (const ScriptSegment& s : r.loop->script().segments()) {
       EXPECT_NE(r.history.find(">" + s.name + "</text>"), std::string::npos) << s.name;
     }
-    for (const char* label : {">t_s<", "p - X(theta_V), mm", "p - X(theta_R), mm",
-                              "force F, N", ">F_x<", ">|F|<"}) {
+    for (const char* label : {">t (s)<", "p - X(theta_V) (mm)", "p - X(theta_R) (mm)",
+                              "force F (N)", ">F_x<", ">|F|<"}) {
       EXPECT_NE(r.history.find(label), std::string::npos) << label;
     }
   }

@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <string>
 #include <vector>
@@ -177,7 +178,8 @@ TEST(ReportHtmlTest, RealRunsOfTheSixCasesAreAllOnThePage) {
         read_file_text((dir / j.name / "summary.json").string()));
     for (const nlohmann::json& c : summary.at("claims")) {
       const std::string name = c.at("name");
-      EXPECT_NE(html.find("<td>" + name + "</td>"), std::string::npos) << name;
+      EXPECT_NE(html.find("id=\"" + j.name + "-claim-" + name + "\"><td>" + name + "</td>"),
+                std::string::npos) << name;
       ++total;
       passed += c.at("pass") == true ? 1 : 0;
       failed += c.at("pass") == false ? 1 : 0;
@@ -191,8 +193,29 @@ TEST(ReportHtmlTest, RealRunsOfTheSixCasesAreAllOnThePage) {
   EXPECT_EQ(testing::count(html, "render unavailable: no renderer in this build"), 6u);
   // the force field of every case: one panel for the circles (cases 1-4),
   // three for the spheres (5, 6)
-  EXPECT_EQ(testing::count(html, "id=\"ff-xy\""), 6u);
-  EXPECT_EQ(testing::count(html, "id=\"ff-zy\""), 2u);
+  EXPECT_EQ(testing::count(html, "-force-field-ff-xy\""), 6u);
+  EXPECT_EQ(testing::count(html, "-force-field-ff-zy\""), 2u);
+  // every id on the page once: the figures' own ids are prefixed per figure
+  std::map<std::string, int> ids;
+  const std::regex id_attr(R"re(\sid="([^"]*)")re");
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), id_attr);
+       it != std::sregex_iterator(); ++it) {
+    ++ids[(*it)[1].str()];
+  }
+  EXPECT_GT(ids.size(), 50u);
+  for (const auto& [id, n] : ids) EXPECT_EQ(n, 1) << id;
+}
+
+TEST(ReportHtmlTest, InlineSvgPrefixesItsIdsAndTheirReferences) {
+  const std::string svg =
+      "<svg><defs><clipPath id=\"plot-clip\"><rect/></clipPath></defs>"
+      "<g clip-path=\"url(#plot-clip)\" data-id=\"keep\"><use href=\"#m\"/>"
+      "<use xlink:href=\"#m\"/><a href=\"https://x\"/></g>\n<path\nid=\"m\"/></svg>";
+  EXPECT_EQ(inline_svg(svg, "f1-"),
+            "<svg><defs><clipPath id=\"f1-plot-clip\"><rect/></clipPath></defs>"
+            "<g clip-path=\"url(#f1-plot-clip)\" data-id=\"keep\"><use href=\"#f1-m\"/>"
+            "<use xlink:href=\"#f1-m\"/><a href=\"https://x\"/></g>\n<path\nid=\"f1-m\"/></svg>");
+  EXPECT_EQ(inline_svg(svg), svg);
 }
 
 TEST(ReportHtmlTest, LoadNamesAMissingSummary) {
@@ -238,9 +261,18 @@ TEST(ReportHtmlTest, AFailingClaimIsMarkedAndARenderEmbedded) {
   EXPECT_EQ(check_page(html), 1);
   EXPECT_NE(html.find("render unavailable: no GL context"), std::string::npos);
   // the failing claim's row, and nothing else, is marked
-  const std::regex fail_row(R"(<tr class="fail"><td>drifts_far</td>[\s\S]*?FAIL</td>)");
+  const std::regex fail_row(R"(<tr class="fail" id="case2-claim-drifts_far"><td>drifts_far</td>[\s\S]*?FAIL</td>)");
   EXPECT_TRUE(std::regex_search(html, fail_row));
-  EXPECT_EQ(html.find("<tr class=\"fail\"><td>held_near</td>"), std::string::npos);
+  EXPECT_EQ(html.find("<tr class=\"fail\" id=\"case1-claim-held_near\">"), std::string::npos);
+  // the first screen: the matrix before any case's section, its failing
+  // cell linked to the claim's row; the build's details at the end
+  const std::size_t matrix = html.find("<table class=\"matrix\">");
+  ASSERT_NE(matrix, std::string::npos);
+  EXPECT_LT(matrix, html.find("<section id=\"case1\">"));
+  EXPECT_LT(html.find("<table class=\"runtime\">"), html.find("<section id=\"case1\">"));
+  EXPECT_NE(html.find("<td class=\"fail\"><a href=\"#case2-claim-drifts_far\">FAIL</a></td>"),
+            std::string::npos);
+  EXPECT_GT(html.find("<table class=\"header\">"), html.find("<section id=\"extremes\">"));
   EXPECT_NE(html.find("<tr class=\"fail\"><td>gain_x100</td>"), std::string::npos);
   EXPECT_NE(html.find("3/4"), std::string::npos);
   EXPECT_NE(html.find("case2:drifts_far"), std::string::npos);
@@ -248,6 +280,35 @@ TEST(ReportHtmlTest, AFailingClaimIsMarkedAndARenderEmbedded) {
   const ClaimTally t = tally_claims(in.cases);
   EXPECT_EQ(t.passed, 3);
   EXPECT_EQ(t.total, 4);
+}
+
+// A claim that holds on one side only: its verdict names the side where it
+// fails, and every side is listed with its value and prediction, the
+// failing one marked; the value, threshold and prediction share one cell.
+TEST(ReportHtmlTest, APartialClaimNamesItsFailingSide) {
+  ReportInputs in;
+  ReportCase c;
+  c.name = "case2";
+  nlohmann::json k = claim("bends", 0.7, true);
+  k["pass"] = "partial";
+  k["prediction"] = 0.72;
+  k["matches_prediction"] = true;
+  k["sides"] = {{{"where", "left of the pivot"}, {"value", 0.95}, {"pass", true},
+                 {"prediction", 0.96}, {"matches_prediction", true}},
+                {{"where", "right of the pivot"}, {"value", 0.41}, {"pass", false},
+                 {"prediction", 0.4}, {"matches_prediction", true}}};
+  c.summary = {{"thesis_case", 2}, {"claims", {k}}};
+  in.cases.push_back(c);
+  const std::string html = report_html(in);
+  EXPECT_NE(html.find("<td class=\"partial\"><a href=\"#case2-claim-bends\">"
+                      "partial: fails right of the pivot</a></td>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<td>0.7 &lt;= 1 mm (law: 0.72, agrees)</td>"), std::string::npos);
+  EXPECT_NE(html.find("<li>left of the pivot: 0.95 &lt;= 1 mm (law: 0.96, agrees), holds</li>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<li class=\"fail\">right of the pivot: 0.41 &lt;= 1 mm (law: 0.4, "
+                      "agrees), FAILS</li>"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -189,3 +189,45 @@ TEST(Overlay, SceneGeomsFollowMujocosConnectorConvention) {
 
 }  // namespace
 }  // namespace vmh::viz
+
+namespace vmh::viz {
+namespace {
+
+// The hand: two pads either side of the target's pen axis, 11 mm off it,
+// and a spring whose segments run from the target to the grip site without
+// a gap (each starts where the last ended), its zig-zag within 3 mm of the
+// line. Exact to rounding.
+TEST(Overlay, HandIsTwoPadsAndASpringFromTargetToGrip) {
+  const Vec3 target(0.1, 0.02, -0.1);
+  const Mat3 R = Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  const Vec3 grip = target + Vec3(0.01, -0.02, 0.005);
+  std::vector<OverlayPrimitive> prims;
+  hand_primitives(target, R, grip, &prims);
+  ASSERT_GT(prims.size(), 4u);
+  EXPECT_EQ(prims[0].id, OverlayId::kHandTarget);
+  EXPECT_EQ(prims[1].id, OverlayId::kHandTarget);
+  for (int i = 0; i < 2; ++i) {
+    const Vec3 mid = 0.5 * (prims[i].a_m + prims[i].b_m);
+    EXPECT_NEAR((mid - target).norm(), 0.011, 1e-12);
+    EXPECT_NEAR(std::abs((prims[i].b_m - prims[i].a_m).normalized().dot(R.col(2))),
+                1.0, 1e-12);
+    EXPECT_LT(prims[i].rgba[3], 1.0f);  // translucent
+  }
+  Vec3 at = target;
+  const Vec3 u = (grip - target).normalized();
+  for (std::size_t i = 2; i < prims.size(); ++i) {
+    EXPECT_EQ(prims[i].id, OverlayId::kHandSpring);
+    EXPECT_LT((prims[i].a_m - at).norm(), 1e-15);
+    const Vec3 off = (prims[i].b_m - target) - u.dot(prims[i].b_m - target) * u;
+    EXPECT_LE(off.norm(), 0.003 + 1e-12);
+    at = prims[i].b_m;
+  }
+  EXPECT_LT((at - grip).norm(), 1e-15);
+  // no spring when the grip sits on its target
+  prims.clear();
+  hand_primitives(target, R, target, &prims);
+  EXPECT_EQ(prims.size(), 2u);
+}
+
+}  // namespace
+}  // namespace vmh::viz

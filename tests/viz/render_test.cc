@@ -214,7 +214,7 @@ TEST(SceneRenderer, MissingCameraIsNamedWithTheModelsCameras) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("'nosuchcam'"), std::string::npos)
         << e.what();
-    EXPECT_NE(std::string(e.what()).find("no named cameras"),
+    EXPECT_NE(std::string(e.what()).find("front, three_quarter, side, top"),
               std::string::npos)
         << e.what();
   }
@@ -300,6 +300,75 @@ TEST(RenderFileName, CarriesTheTimeInMilliseconds) {
   EXPECT_EQ(vmh::viz::render_file_name("case1", 2.5), "case1_t002500ms.png");
   EXPECT_EQ(vmh::viz::render_file_name("case3", 0.0), "case3_t000000ms.png");
   EXPECT_EQ(vmh::viz::render_file_name("x", 1234.5678), "x_t1234568ms.png");
+}
+
+}  // namespace
+
+namespace {
+
+// The named cameras of models/omni/stage.xml frame the whole device and
+// its VM, lit, at 4:3 and at 16:9 (issue 31). Case 1 at 5 s, when the hand
+// has raised the upper arm above the shoulder (the highest pose of its
+// script), seen by each camera:
+//   - the device (every geom but the desk, from MuJoCo's segmentation
+//     rendering) covers between 4 % and 60 % of the frame, and none of its
+//     pixels lies on the frame's border: it is all in the picture;
+//   - the mean luminance of its pixels in the ordinary render (Rec. 709
+//     weights, 0..255) is at least 70: it is lit, not a silhouette;
+//   - the VM's circle (48 points of it) projects inside the frame.
+// The figures are printed, for docs/viewer.md.
+TEST(SceneRenderer, EveryNamedCameraFramesTheWholeLitDevice) {
+  vmh::sim::ClosedLoop loop(kCase1, {});
+  vmh::TickRecord row;
+  while (loop.time_s() < 5.0 - 1e-9) loop.tick(&row);
+  std::vector<vmh::viz::OverlayPrimitive> path;
+  vmh::viz::OverlayOptions opt;
+  opt.mechanism = opt.stylus = opt.force = false;
+  opt.circle_segments = 48;
+  vmh::viz::overlay_primitives(loop.controller().mechanism(),
+                               loop.controller_params(), row.out, opt, &path);
+  ASSERT_EQ(path.size(), 48u);
+  const mjModel* m = loop.model();
+  const int desk = mj_name2id(m, mjOBJ_GEOM, "desk");
+  ASSERT_GE(desk, 0);
+  vmh::viz::GlContext gl;
+  vmh::viz::SceneRenderer r(m, loop.controller_params().omni, 640, 480);
+  const std::vector<std::string> cams = vmh::viz::camera_names(m);
+  ASSERT_EQ(cams, (std::vector<std::string>{"front", "three_quarter", "side", "top"}));
+  for (const std::string& cam : cams) {
+    for (const auto& [w, h] : {std::pair{640, 480}, std::pair{640, 360}}) {
+      SCOPED_TRACE(cam + " " + std::to_string(w) + "x" + std::to_string(h));
+      const std::vector<int> ids = r.render_geom_ids(m, loop.data(), w, h, cam);
+      const std::vector<std::uint8_t> rgb =
+          r.render_rgb(m, loop.data(), {}, w, h, cam);
+      long device = 0, border = 0;
+      double luminance = 0.0;
+      for (int v = 0; v < h; ++v) {
+        for (int u = 0; u < w; ++u) {
+          const std::size_t i = static_cast<std::size_t>(v) * w + u;
+          if (ids[i] < 0 || ids[i] == desk) continue;
+          ++device;
+          if (u == 0 || v == 0 || u == w - 1 || v == h - 1) ++border;
+          luminance += 0.2126 * rgb[3 * i] + 0.7152 * rgb[3 * i + 1] +
+                       0.0722 * rgb[3 * i + 2];
+        }
+      }
+      const double share = static_cast<double>(device) / (w * h);
+      const double mean_lum = device > 0 ? luminance / device : 0.0;
+      std::cout << "camera " << cam << " " << w << "x" << h
+                << ": device share " << share << ", mean luminance "
+                << mean_lum << "\n";
+      EXPECT_GT(share, 0.04);
+      EXPECT_LT(share, 0.60);
+      EXPECT_EQ(border, 0) << "the device is cut by the frame's edge";
+      EXPECT_GT(mean_lum, 70.0);
+      for (const auto& seg : path) {
+        const Pixel p = project(r.scene(), w, h, seg.a_m);
+        EXPECT_TRUE(p.u > 0 && p.u < w && p.v > 0 && p.v < h)
+            << "the VM's path leaves the frame at (" << p.u << ", " << p.v << ")";
+      }
+    }
+  }
 }
 
 }  // namespace
