@@ -588,8 +588,8 @@ int read_numbers(HdDevice* d, HDenum p, double* out) {
   }
 }
 
-template <typename T>
-void get_numbers(HDenum p, T* params) {
+template <typename T, typename Convert>
+void get_numbers(HDenum p, T* params, Convert convert) {
   if (params == nullptr) {
     push_error(HD_INVALID_VALUE, kInternalNone, current_handle());
     return;
@@ -604,25 +604,21 @@ void get_numbers(HDenum p, T* params) {
                kInternalUnknownParameter, current_handle());
     return;
   }
-  for (int i = 0; i < n; ++i) params[i] = static_cast<T>(v[i]);
+  for (int i = 0; i < n; ++i) params[i] = convert(v[i]);
+}
+
+template <typename T>
+void get_numbers(HDenum p, T* params) {
+  get_numbers(p, params, [](double v) { return static_cast<T>(v); });
 }
 
 }  // namespace
 
 HDAPI void HDAPIENTRY hdGetBooleanv(HDenum p, HDboolean* params) {
-  if (params == nullptr) {
-    push_error(HD_INVALID_VALUE, kInternalNone, current_handle());
-    return;
-  }
-  HdDevice* d = current_device();
-  if (d == nullptr) return;
-  double v[36];
-  const int n = read_numbers(d, p, v);
-  if (n == 0) {
-    push_error(HD_INVALID_ENUM, kInternalUnknownParameter, current_handle());
-    return;
-  }
-  for (int i = 0; i < n; ++i) params[i] = v[i] != 0.0 ? HD_TRUE : HD_FALSE;
+  // any non-zero value is HD_TRUE (a button mask read as a boolean)
+  get_numbers(p, params, [](double v) -> HDboolean {
+    return v != 0.0 ? HD_TRUE : HD_FALSE;
+  });
 }
 HDAPI void HDAPIENTRY hdGetIntegerv(HDenum p, HDint* params) { get_numbers(p, params); }
 HDAPI void HDAPIENTRY hdGetFloatv(HDenum p, HDfloat* params) { get_numbers(p, params); }
