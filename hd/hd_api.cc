@@ -373,17 +373,17 @@ HDAPI void HDAPIENTRY hdDisableDevice(HHD h) {
   for (HHD i = 0; i < static_cast<HHD>(kMaxDevices); ++i) {
     if (i != h && device_of(i) != nullptr) others = true;
   }
-  // the last device: the scheduler stops with it
-  if (!others) hdStopScheduler();
-  std::lock_guard<std::mutex> lock(c.mu);
-  if (c.running.load()) {
-    // other devices still run: this one leaves the tick first
+  // the scheduler's ticks hold every device: it stops while one leaves,
+  // and starts again for the others (docs/libhd.md)
+  const bool was_running = c.running.load();
+  if (was_running) hdStopScheduler();
+  {
+    std::lock_guard<std::mutex> lock(c.mu);
     c.live[h].store(nullptr, std::memory_order_release);
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    c.devices[h]->send_zero();
+    c.devices[h].reset();
   }
-  c.live[h].store(nullptr, std::memory_order_release);
-  c.devices[h]->send_zero();
-  c.devices[h].reset();
+  if (was_running && others) hdStartScheduler();
   if (c.current.load() == h) c.current.store(HD_INVALID_HANDLE);
   if (t_current == h) t_current = HD_INVALID_HANDLE;
 }
