@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
@@ -847,21 +848,32 @@ HDAPI void HDAPIENTRY hdStartScheduler(void) {
     return;
   }
   if (lockstep) {
-    // one servo period of every plant per tick, paced to the wall clock
-    // unless VMH_HD_PACE=free
+    // one servo period of every plant per tick, paced to the wall clock:
+    // VMH_HD_PACE=free runs as fast as it can, VMH_HD_PACE=F (a number > 0)
+    // F times faster than real time
     const char* pace = std::getenv("VMH_HD_PACE");
-    const bool paced = pace == nullptr || std::string(pace) != "free";
+    double factor = 1.0;
+    if (pace != nullptr && *pace != '\0') {
+      if (std::string(pace) == "free") {
+        factor = 0.0;
+      } else {
+        char* end = nullptr;
+        const double f = std::strtod(pace, &end);
+        if (end != pace && *end == '\0' && std::isfinite(f) && f > 0.0) factor = f;
+      }
+    }
     c.lockstep_run.store(true);
-    c.lockstep_thread = std::thread([devs, n, period_s, paced]() mutable {
+    c.lockstep_thread = std::thread([devs, n, period_s, factor]() mutable {
       Context& cc = ctx();
       const auto t0 = std::chrono::steady_clock::now();
       std::int64_t k = 0;
       while (cc.lockstep_run.load(std::memory_order_acquire)) {
         for (int i = 0; i < n; ++i) devs[i]->backend()->pass(period_s);
         ++k;
-        if (paced) {
+        if (factor > 0.0) {
           std::this_thread::sleep_until(
-              t0 + std::chrono::duration<double>(static_cast<double>(k) * period_s));
+              t0 + std::chrono::duration<double>(static_cast<double>(k) *
+                                                 period_s / factor));
         }
       }
     });
