@@ -119,8 +119,13 @@ def main():
     check("hdScheduleAsynchronous")
     hd.hdStartScheduler()
     check("hdStartScheduler")
-    if errors:
-        print(json.dumps({"error": "the scheduler did not start", "errors": errors}))
+    # the servo callback appends its own errors from the servo thread (the
+    # impulse limit at the spring's onset): only the start's count here
+    started = [e for e in errors if e["where"] == "hdStartScheduler"]
+    if started:
+        hd.hdStopScheduler()  # never leave the servo thread calling into
+        hd.hdDisableDevice(h)  # an interpreter that is shutting down
+        print(json.dumps({"error": "the scheduler did not start", "errors": started}))
         return 2
     time.sleep(args.seconds)
     hd.hdStopScheduler()
