@@ -5,7 +5,7 @@
 // by name.
 //
 // Who registers what (one line each):
-//   hw/backends.cc        openhaptics, firewire, usb        (no MuJoCo)
+//   hw/backends.cc        openhaptics, firewire, usb, served (no MuJoCo)
 //   sim/emulator_backend  emulator, emulator:firewire       (MuJoCo)
 // The command line calls hw::register_backends() and, where the build has
 // the testbed, sim::register_backends() before it parses.
