@@ -149,6 +149,7 @@ class ClosedLoop {
   // the servo chain (its safety layer, when the case has one)
   ServoChain& chain() { return *chain_; }
   SimHand& hand() { return *hand_; }
+  const SimHand& hand() const { return *hand_; }
   // Sets the hand's target (and its velocity) for simulated time t_s from
   // the script, as tick() does before it steps: what a caller that steps
   // data() itself (a viewer, a test) does to play the script.

@@ -147,6 +147,7 @@ struct Emulator::PhysicsState {
   bool watchdog_fired = false;
   bool invalid_command = false;
   bool stalled = false;
+  bool manual_held = false;
   ScriptPose target;
   int segment = 0;
   HandProgram program = HandProgram::kTour;
@@ -196,7 +197,22 @@ Emulator::Emulator(const EmulatorOptions& options) : options_(options) {
   for (const EmulatorFault& f : options_.faults) inject(f);
 }
 
-Emulator::~Emulator() { stop(); }
+Emulator::~Emulator() {
+  stop();
+  if (mirror_ != nullptr) mj_deleteData(mirror_);
+}
+
+void Emulator::enable_mirror() {
+  if (running()) throw std::logic_error("Emulator::enable_mirror: call it before start()");
+  if (mirror_ == nullptr) mirror_ = mj_makeData(loop_->model());
+}
+
+bool Emulator::copy_mirror(mjData* d) const {
+  std::lock_guard<std::mutex> lock(mirror_mutex_);
+  if (mirror_ == nullptr || !mirror_filled_) return false;
+  mj_copyData(d, loop_->model(), mirror_);
+  return true;
+}
 
 Vec3 Emulator::inkwell_mm() const noexcept { return ps_->hand.inkwell_mm(); }
 Vec3 Emulator::inkwell_axis() const noexcept { return ps_->hand.inkwell_axis(); }
@@ -414,6 +430,17 @@ double Emulator::step_period() noexcept {
   const HandProgram program = static_cast<HandProgram>(program_.load());
   ps.program = program;
   ps.hand.set_target(program, ps.t_sim_s, &ps.target, &ps.segment);
+  bool let_go = program == HandProgram::kNone;
+  ps.manual_held = false;
+  if (program == HandProgram::kManual) {
+    const ManualHand mh = manual_.read();
+    ps.manual_held = mh.held;
+    let_go = !mh.held;
+    if (mh.held) {
+      loop_->hand().set_target(loop_->model(), loop_->data(), mh.target);
+      ps.target = ps.hand.wrist_pose_of(mh.target);
+    }
+  }
   // the command reaches the motors through SimDevice: its clamps and its
   // delay line (one write per period)
   loop_->device().write_motor_torques(motor_command(clock_s()));
@@ -423,7 +450,7 @@ double Emulator::step_period() noexcept {
   const mjModel* m = loop_->model();
   mjData* d = loop_->data();
   for (int i = 0; i < substeps_; ++i) {
-    if (program == HandProgram::kNone) ps.hand.let_go();
+    if (let_go) ps.hand.let_go();
     mju_copy(ps.qpos_before.data(), d->qpos, m->nq);
     mj_step(m, d);
     // the passivity observer, as ClosedLoop::tick keeps it
@@ -436,6 +463,14 @@ double Emulator::step_period() noexcept {
   t_sim_now_s_.store(ps.t_sim_s, std::memory_order_relaxed);
   publish(clock_s());
   ps.stalled = false;
+  if (mirror_ != nullptr && ps.periods % kMirrorPeriods == 0) {
+    // a viewer's copy; never waits for the viewer
+    std::unique_lock<std::mutex> lock(mirror_mutex_, std::try_to_lock);
+    if (lock.owns_lock()) {
+      mj_copyData(mirror_, m, d);
+      mirror_filled_ = true;
+    }
+  }
   return 0.0;
 }
 
@@ -504,6 +539,7 @@ void Emulator::publish(double now_s) noexcept {
   t.state_finite = all_finite(d->qpos, m->nq) && all_finite(d->qvel, m->nv) &&
                    all_finite(d->qacc, m->nv) && all_finite(d->ctrl, m->nu);
   t.docked = s.docked;
+  t.manual_held = ps.manual_held;
   t.device_watchdog_fired = ps.watchdog_fired;
   t.invalid_command = ps.invalid_command;
   t.unplugged = unplugged_.load(std::memory_order_relaxed);

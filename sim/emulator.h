@@ -78,6 +78,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -87,6 +88,7 @@
 #include "device/seqlock.h"
 #include "device/tick_record.h"
 #include "hw/omni_calibration.h"
+#include "sim/hand.h"
 #include "sim/hand_script.h"
 #include "sim/omni_model_edit.h"
 
@@ -121,6 +123,10 @@ enum class HandProgram {
   // back (kSweepLeg_s per leg), the target 0.15 rad past the end so that
   // the hand's rotational spring presses it against the joint limit
   kGimbalSweep,
+  // a hand another thread moves (Emulator::set_manual_hand: a viewer's
+  // mouse): while held, the hand's spring pulls the grip toward the target
+  // given; while not held it lets go, as kNone
+  kManual,
 };
 const char* hand_program_name(HandProgram p);  // "case", "tour", ...
 // throws std::invalid_argument naming the unknown program
@@ -246,6 +252,7 @@ struct EmulatorTruth : PlantTruth {
   Vec3 stylus_axis = Vec3::UnitZ();   // true stylus axis at the end, unit
   HandProgram program = HandProgram::kTour;
   bool docked = false;
+  bool manual_held = false;  // kManual: the hand holds the stylus
   bool device_watchdog_fired = false;  // zero held: no write in time
   bool invalid_command = false;        // the last write was not finite
   bool unplugged = false;
@@ -291,6 +298,22 @@ class Emulator final : public HapticDevice {
   EmulatorTruth truth() const noexcept { return truth_.read(); }
   DeviceIdentity identity() const;
 
+  // kManual's hand: the grip's target (world = DH base frame, SI, as
+  // SimHand::set_target takes it) and whether the hand holds the stylus;
+  // used from the next period. Any thread; no allocation.
+  void set_manual_hand(const HandTargetState& target, bool held) noexcept {
+    manual_.write(ManualHand{target, held});
+  }
+
+  // A copy of the physics for a viewer: enable_mirror() (before start())
+  // makes the physics thread copy its mjData into a mirror every
+  // kMirrorPeriods periods (skipping a copy rather than waiting when a
+  // reader holds it); copy_mirror() copies the mirror into d (made for
+  // loop().model()), false before the first copy. Any thread.
+  static constexpr int kMirrorPeriods = 4;
+  void enable_mirror();
+  bool copy_mirror(mjData* d) const;
+
   void press_buttons(std::uint32_t mask) noexcept { buttons_.store(mask); }
   void set_hand_program(HandProgram p) noexcept {
     program_.store(static_cast<int>(p));
@@ -333,6 +356,10 @@ class Emulator final : public HapticDevice {
     std::uint64_t count = 0;  // writes so far
     bool invalid = false;
   };
+  struct ManualHand {
+    HandTargetState target;
+    bool held = false;
+  };
   struct FaultSlot {
     std::atomic<bool> ready{false};
     std::atomic<bool> taken{false};  // the physics thread has acted on it
@@ -364,6 +391,11 @@ class Emulator final : public HapticDevice {
   Seqlock<Command> command_;
   Seqlock<EmulatorTruth> truth_;
   Seqlock<Published> state_;
+  Seqlock<ManualHand> manual_;
+  // the viewer's mirror (enable_mirror)
+  mutable std::mutex mirror_mutex_;
+  mjData* mirror_ = nullptr;
+  bool mirror_filled_ = false;  // under mirror_mutex_
   std::atomic<std::uint32_t> buttons_{0};
   std::atomic<int> program_{0};
   std::atomic<int> drops_{0};

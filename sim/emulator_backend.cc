@@ -331,8 +331,9 @@ const std::vector<runtime::BackendOption>& emulator_option_list() {
   // the faults' help comes from the one fault table (sim/fault_vocabulary.h)
   static const std::vector<runtime::BackendOption> options = {
       {"hand",
-       "what holds the emulated stylus: case, tour, none, dock, gimbal_sweep "
-       "(default depends on the verb)"},
+       "what holds the emulated stylus: case, tour, none, dock, gimbal_sweep, "
+       "manual (a program's hand, as view --serve-hd's mouse; from here it "
+       "never grabs, so as none) (default depends on the verb)"},
       {"fault",
        "injected faults, comma-separated kind@t[:...] (t: emulator time, s). "
        "emulator: " + fault_help(kTransportFaults) +

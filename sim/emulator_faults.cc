@@ -22,6 +22,7 @@ constexpr ProgramName kPrograms[] = {
     {HandProgram::kNone, "none"},
     {HandProgram::kDock, "dock"},
     {HandProgram::kGimbalSweep, "gimbal_sweep"},
+    {HandProgram::kManual, "manual"},
 };
 
 }  // namespace
@@ -38,7 +39,7 @@ HandProgram parse_hand_program(const std::string& name) {
     if (name == n.name) return n.program;
   }
   throw std::invalid_argument("unknown hand program '" + name +
-                              "' (case, tour, none, dock, gimbal_sweep)");
+                              "' (case, tour, none, dock, gimbal_sweep, manual)");
 }
 
 const char* emulator_fault_name(EmulatorFaultKind k) {

@@ -67,6 +67,7 @@ void EmulatorHand::pose_at(HandProgram p, double tau, Vec3* wrist_m,
   switch (p) {
     case HandProgram::kCase:
     case HandProgram::kNone:
+    case HandProgram::kManual:
       *wrist_m = p_from_m_;
       *R = R_from_;
       return;
@@ -163,9 +164,20 @@ void EmulatorHand::set_target(HandProgram p, double t_s, ScriptPose* target,
   const double dt = 1e-5;
   pose_at(p, tau, &w1, &R1);
   pose_at(p, tau + dt, &w2, &R2);
-  if (p != HandProgram::kNone) send(w1, R1, w2, R2, dt);
+  // kNone lets go and kManual is set by the emulator: neither is sent here
+  if (p != HandProgram::kNone && p != HandProgram::kManual) {
+    send(w1, R1, w2, R2, dt);
+  }
   target->p_mm = base_to_device_mm(omni_, w1);
   target->axis = base_to_device_vector(R1.col(2));
+}
+
+ScriptPose EmulatorHand::wrist_pose_of(const HandTargetState& g) const noexcept {
+  const Mat3 R_stylus = g.R * R_site_.transpose();
+  ScriptPose pose;
+  pose.p_mm = base_to_device_mm(omni_, g.p_m - R_stylus * grip_local_m_);
+  pose.axis = base_to_device_vector(R_stylus.col(2));
+  return pose;
 }
 
 void EmulatorHand::let_go() noexcept {

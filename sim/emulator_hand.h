@@ -23,6 +23,10 @@ class EmulatorHand {
   void set_target(HandProgram p, double t_s, ScriptPose* target,
                   int* segment) noexcept;
 
+  // the wrist pose (device frame, mm; stylus axis) that a grip target
+  // (world frame, SI) asks for: kManual's target as the truth records it
+  ScriptPose wrist_pose_of(const HandTargetState& grip_target) const noexcept;
+
   // kNone: puts the target on the grip's present pose and velocity, so the
   // hand's spring and damper exert nothing at the start of the next step.
   // Call before each mj_step.

@@ -626,6 +626,109 @@ TEST(NoAlloc, EmulatorAdvanceReadWrite) {
   EXPECT_EQ(ok + timeouts + not_connected, 5 * 150);
 }
 
+// the grip site's pose in a copy of the physics (world frame, SI)
+HandTargetState grip_of(const mjModel* m, const mjData* d, int grip) {
+  HandTargetState t;
+  t.p_m = Vec3(d->site_xpos + 3 * grip);
+  t.R = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+      d->site_xmat + 9 * grip);
+  (void)m;
+  return t;
+}
+
+TEST(Emulator, MirrorCopiesThePhysicsOfItsLastCopiedPeriod) {
+  Emulator emu(options(HandProgram::kTour));
+  emu.enable_mirror();
+  const mjModel* m = emu.loop().model();
+  mjData* d = mj_makeData(m);
+  emu.start();
+  EXPECT_FALSE(emu.copy_mirror(d));  // nothing copied yet
+  run(&emu, 10 * Emulator::kMirrorPeriods);  // ends on a copied period
+  ASSERT_TRUE(emu.copy_mirror(d));
+  // the copy is the state the truth describes at the period's end
+  const EmulatorTruth t = emu.truth();
+  for (int i = 0; i < 6; ++i) {
+    const std::string name = "q" + std::to_string(i + 1);
+    const int j = mj_name2id(m, mjOBJ_JOINT, name.c_str());
+    ASSERT_GE(j, 0);
+    EXPECT_EQ(d->qpos[m->jnt_qposadr[j]], t.q_end_dh[i]) << name;
+  }
+  EXPECT_NEAR(d->time, t.t_sim_s, 1e-12);
+  mj_deleteData(d);
+  emu.stop();
+  EXPECT_THROW(
+      {
+        Emulator started(options(HandProgram::kTour));
+        started.start();
+        started.enable_mirror();
+      },
+      std::logic_error);
+}
+
+TEST(Emulator, ManualHandLetsGoUntilHeldThenCarriesTheGrip) {
+  Emulator emu(options(HandProgram::kManual));
+  emu.enable_mirror();
+  const mjModel* m = emu.loop().model();
+  const int grip = emu.loop().hand().grip_site();
+  mjData* d = mj_makeData(m);
+  emu.start();
+  run(&emu, 100);
+  // not held: like "none", the hand exerts (almost) nothing
+  EXPECT_FALSE(emu.truth().manual_held);
+  EXPECT_LT(emu.truth().hand_force_N.norm(), 0.05);
+  ASSERT_TRUE(emu.copy_mirror(d));
+  const HandTargetState start = grip_of(m, d, grip);
+  // held 20 mm along the world x from where the grip is
+  HandTargetState target = start;
+  target.p_m += Vec3(0.02, 0.0, 0.0);
+  emu.set_manual_hand(target, true);
+  run(&emu, 1500);
+  EXPECT_TRUE(emu.truth().manual_held);
+  ASSERT_TRUE(emu.copy_mirror(d));
+  const Vec3 moved = grip_of(m, d, grip).p_m - start.p_m;
+  std::printf("grip moved %.2f mm toward a target 20 mm away (x %.2f, "
+              "off-axis %.2f mm)\n",
+              1e3 * moved.norm(), 1e3 * moved.x(),
+              1e3 * Vec3(0.0, moved.y(), moved.z()).norm());
+  // nothing but the arm's inertia, damping and friction resists the hand
+  EXPECT_GT(moved.x(), 0.015);
+  EXPECT_LT(moved.x(), 0.0205);
+  // the truth's hand target is the wrist pose the grip target asks for:
+  // with the grip nearly there, the true wrist centre is nearly there too
+  const EmulatorTruth t = emu.truth();
+  EXPECT_LT((t.hand_target.p_mm - t.p_end_mm).norm(), 5.0);
+  EXPECT_GT(t.hand_target.axis.dot(t.stylus_axis), 0.99);
+  // let go: the hand's force vanishes again
+  emu.set_manual_hand(target, false);
+  run(&emu, 20);
+  EXPECT_FALSE(emu.truth().manual_held);
+  EXPECT_LT(emu.truth().hand_force_N.norm(), 0.05);
+  mj_deleteData(d);
+  emu.stop();
+  EXPECT_EQ(parse_hand_program("manual"), HandProgram::kManual);
+}
+
+TEST(NoAlloc, EmulatorManualHandAndMirror) {
+  Emulator emu(options(HandProgram::kManual));
+  emu.enable_mirror();
+  emu.start();
+  run(&emu, 10);
+  HandTargetState target;
+  target.p_m = Vec3(0.0, 0.1, 0.1);
+  std::size_t allocations = 0;
+  {
+    vmh::testing::AllocationScope scope;
+    for (int i = 0; i < 200; ++i) {
+      emu.set_manual_hand(target, i % 50 < 25);
+      (void)emu.write_motor_torques(Vec3(0.01, 0.0, 0.0));
+      emu.advance();
+    }
+    allocations = scope.count();
+  }
+  emu.stop();
+  EXPECT_EQ(allocations, 0u);
+}
+
 TEST(Emulator, IdentityNamesTheEmulator) {
   EmulatorOptions o = options(HandProgram::kTour);
   o.serial = "EMU-0042";
