@@ -1,11 +1,13 @@
 // vmhaptics view <case1..case6|scene.xml> [--device D] [--frames N]
 //                [--set name=value ...] [--out DIR] [--mouse]
+// vmhaptics view [case|scene.xml] --serve-hd NAME [--frames N] ...
 //
 // An interactive window (viz/viewer.h, docs/viewer.md): the case's Omni in
 // MuJoCo's renderer, simulated in real time, with the mouse able to take
 // the simulated hand's place; or, with --device, a device's live state.
 // Exit codes: 0 closed, 2 bad usage or input (an unknown case, a bad
-// --set, a device that cannot be opened), 1 any other failure (no display:
+// --set, a device that cannot be opened, a served name that is taken),
+// 1 any other failure (no display:
 // GLFW's reason is in the message).
 #include <CLI/CLI.hpp>
 
@@ -13,11 +15,13 @@
 #include <memory>
 
 #include "cli/args.h"
+#include "device/stop_signal.h"
 #include "runtime/backend_registry.h"
 #include "runtime/session.h"
 #include "runtime/trace_writer.h"
 #include "controller/device_frame.h"
 #include "sim/closed_loop.h"
+#include "sim/served_emulator.h"
 #include "studies/run_case.h"
 #include "viz/viewer.h"
 
@@ -27,6 +31,7 @@ namespace {
 struct ViewOptions {
   std::string target;
   std::string device;  // empty: the viewer's own simulation
+  std::string serve_hd;  // serve the emulator as served:NAME
   int frames = 0;
   std::vector<std::string> sets;
   std::string out = ".";
@@ -95,7 +100,11 @@ std::unique_ptr<LiveDevice> open_live(const ViewOptions& o,
   return live;
 }
 
-void view(const ViewOptions& o) {
+void view(ViewOptions o) {
+  if (o.target.empty()) {
+    if (o.serve_hd.empty()) throw UsageError("view: give a case or a scene (target)");
+    o.target = "case1";
+  }
   if (o.frames < 0) throw UsageError("--frames: must be >= 0");
   if (o.width_px < 64 || o.height_px < 64) {
     throw UsageError("--width, --height: each must be at least 64 px");
@@ -132,8 +141,38 @@ void view(const ViewOptions& o) {
   vo.screenshot_last_frame = o.screenshot;
   vo.width_px = o.width_px;
   vo.height_px = o.height_px;
+  // Ctrl-C and kill end the window's loop like its close button, so that
+  // a device is left at zero torque and a served name is removed
+  StopSignals signals;
+  vo.stop_requested = [&signals] { return signals.requested(); };
   std::unique_ptr<LiveDevice> live;
-  if (!o.device.empty()) {
+  std::unique_ptr<sim::ServedEmulator> served;
+  if (!o.serve_hd.empty()) {
+    if (!o.device.empty() || o.mouse) {
+      throw UsageError("--serve-hd: the served emulator is driven by a client "
+                       "program and held by the mouse; not with --device or "
+                       "--mouse");
+    }
+    sim::ServedEmulatorOptions so;
+    so.name = o.serve_hd;
+    so.scene = scene;
+    so.overrides = o.sets;
+    try {
+      served = std::make_unique<sim::ServedEmulator>(so);
+    } catch (const sim::SimError& e) {
+      throw UsageError(std::string("view: ") + e.what());
+    }
+    served->start();
+    vo.cases = {{name, scene}};
+    vo.case_index = 0;
+    vo.served = served.get();
+    std::fprintf(stderr,
+                 "vmhaptics view: serving the emulated Omni of %s as %s; run "
+                 "an OpenHaptics program on it with\n"
+                 "  VMH_HD_DEVICE=%s LD_LIBRARY_PATH=<build>/lib program\n"
+                 "(left-drag grabs the stylus, release lets go)\n",
+                 name.c_str(), served->spec().c_str(), served->spec().c_str());
+  } else if (!o.device.empty()) {
     live = open_live(o, scene, &vo);
   } else {
     // bad --set values are usage errors even where no window can open
@@ -176,8 +215,15 @@ void register_view(CLI::App* app) {
       "the view plane, shift+left-drag turns it; right-drag turns the "
       "camera, middle-drag pans, scroll zooms. docs/viewer.md");
   cmd->add_option("target", o->target,
-                  "case1..case6, or the path of a scene .xml")
-      ->required();
+                  "case1..case6, or the path of a scene .xml (with "
+                  "--serve-hd: whose Omni and hand; default case1)");
+  cmd->add_option("--serve-hd", o->serve_hd,
+                  "serve the emulated Omni to other programs as the device "
+                  "served:NAME (an OpenHaptics program on the project's "
+                  "libHD.so with VMH_HD_DEVICE=served:NAME, or hw verbs with "
+                  "--device served:NAME) and show it here; nobody holds the "
+                  "stylus until a left-drag grabs it (the mouse is the hand), "
+                  "release lets go. docs/libhd.md");
   cmd->add_option("--device", o->device,
                   "show a device's live state instead of simulating: "
                   "emulator (plays the target scene) or a backend as in the "

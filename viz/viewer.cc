@@ -12,7 +12,9 @@
 #include <filesystem>
 
 #include "controller/device_frame.h"
+#include "controller/omni_kinematics.h"
 #include "sim/closed_loop.h"
+#include "sim/served_emulator.h"
 #include "viz/png.h"
 #include "viz/scene_renderer.h"
 #include "viz/viewer_hud.h"
@@ -37,7 +39,8 @@ std::string number(double v) {
 
 Viewer::Viewer(const ViewerOptions& options)
     : opt_(options), case_index_(options.case_index),
-      mouse_hand_(options.start_with_mouse_hand && !options.live) {
+      mouse_hand_((options.start_with_mouse_hand && !options.live) ||
+                  options.served != nullptr) {
   if (opt_.cases.empty()) throw ViewerError("view: no case to show");
   if (case_index_ < 0 || case_index_ >= static_cast<int>(opt_.cases.size())) {
     throw ViewerError("view: case index " + std::to_string(case_index_) +
@@ -83,6 +86,7 @@ void Viewer::set_named_camera(int step) {
 }
 
 Viewer::~Viewer() {
+  if (opt_.served != nullptr) opt_.served->release();
   sim_.reset();  // joins the physics thread
   if (d_render_ != nullptr) mj_deleteData(d_render_);
   if (scene_made_) {
@@ -97,7 +101,9 @@ const std::string& Viewer::case_name() const {
 
 bool Viewer::paused() const { return sim_ && sim_->paused(); }
 
-const mjModel* Viewer::model() const { return sim_->model(); }
+const mjModel* Viewer::model() const {
+  return opt_.served != nullptr ? opt_.served->model() : sim_->model();
+}
 
 void Viewer::build_case() {
   const bool was_paused = paused();
@@ -105,6 +111,22 @@ void Viewer::build_case() {
   if (d_render_ != nullptr) {
     mj_deleteData(d_render_);
     d_render_ = nullptr;
+  }
+  if (opt_.served != nullptr) {
+    // the served emulator's own physics: nothing to build but the copy
+    overlay_controller_ =
+        std::make_unique<Controller>(opt_.served->loop().controller_params());
+    hud_->set_served(true);
+    const mjModel* m = model();
+    d_render_ = mj_makeData(m);
+    if (!scene_made_) {
+      mjv_makeScene(m, &scn_, 5000);
+      mjr_makeContext(m, &con_, mjFONTSCALE_150);
+      scene_made_ = true;
+    }
+    out_ = ControlOutput{};
+    prims_.clear();
+    return;
   }
   const ViewerCase& c = opt_.cases[static_cast<std::size_t>(case_index_)];
   std::vector<std::string> sets = opt_.overrides;
@@ -143,8 +165,63 @@ void Viewer::build_case() {
   if (!opt_.live) sim_->start();
 }
 
+void Viewer::record_live_plot(double t_s) {
+  // the plots from the readings the frames saw (no physics thread here)
+  auto& buf = *plots_;
+  if (live_plot_n_ == kPlotSamples) {
+    std::copy(buf.begin() + 1, buf.end(), buf.begin());
+    --live_plot_n_;
+  }
+  buf[static_cast<std::size_t>(live_plot_n_++)] = PlotSample{
+      static_cast<float>(t_s), static_cast<float>(d_path_mm_),
+      static_cast<float>(out_.force_device_N.norm())};
+  hud_->set_samples(buf.data(), live_plot_n_);
+}
+
+void Viewer::copy_from_served() {
+  sim::ServedEmulator& se = *opt_.served;
+  if (!se.copy(d_render_)) {
+    status_ = "starting";
+    return;
+  }
+  const sim::EmulatorTruth truth = se.truth();
+  const hw::served::ServedState pub = se.published();
+  t_sim_s_ = truth.t_sim_s;
+  // what the overlay draws: the stylus at the wrist centre and the force
+  // the client's motor torques make there, F = (J^T)^-1 tau, with J the
+  // device's own Jacobian of the reading (device frame, mm/rad, columns
+  // t1..t3), tau in N m -> F in N
+  out_ = ControlOutput{};
+  out_.p_rm_mm = truth.p_end_mm;
+  out_.axis_rm = truth.stylus_axis;
+  if (pub.state.has(kStateJacobian)) {
+    const Mat3 Jt = pub.state.jacobian.block<3, 3>(0, 0).transpose();
+    const Eigen::FullPivLU<Mat3> lu(Jt);
+    if (lu.isInvertible()) out_.force_device_N = lu.solve(pub.tau_applied_Nm) * 1e3;
+  }
+  have_output_ = true;
+  const hw::served::ServerStats st = se.server();
+  char buf[200];
+  const Vec3 tau_mNm = pub.tau_applied_Nm * 1e3;
+  std::snprintf(buf, sizeof buf,
+                "client %s, command %s, tau (%.0f, %.0f, %.0f) mN m",
+                st.client_pid != 0 ? ("pid " + std::to_string(st.client_pid)).c_str()
+                                   : "none",
+                hw::served::command_state_name(st.command_state), tau_mNm[0],
+                tau_mNm[1], tau_mNm[2]);
+  status_ = buf;
+  // the upper plot: the hand's force (N), who pushes the stylus
+  hand_force_N_ = truth.hand_force_N.norm();
+  d_path_mm_ = hand_force_N_;
+  record_live_plot(t_sim_s_);
+}
+
 void Viewer::copy_from_physics() {
   const mjModel* m = model();
+  if (opt_.served != nullptr) {
+    copy_from_served();
+    return;
+  }
   if (opt_.live) {
     // the device's reading poses the model; nothing is simulated here
     const LiveSample s = opt_.live();
@@ -163,16 +240,7 @@ void Viewer::copy_from_physics() {
                      out_.p_rm_mm / overlay_controller_->params().length_unit_mm) *
                  overlay_controller_->params().length_unit_mm;
     have_output_ = true;
-    // the plots from the readings the frames saw (no physics thread here)
-    auto& buf = *plots_;
-    if (live_plot_n_ == kPlotSamples) {
-      std::copy(buf.begin() + 1, buf.end(), buf.begin());
-      --live_plot_n_;
-    }
-    buf[static_cast<std::size_t>(live_plot_n_++)] = PlotSample{
-        static_cast<float>(s.t_s), static_cast<float>(d_path_mm_),
-        static_cast<float>(out_.force_device_N.norm())};
-    hud_->set_samples(buf.data(), live_plot_n_);
+    record_live_plot(s.t_s);
     return;
   }
   TickRecord row;
@@ -198,9 +266,12 @@ void Viewer::render() {
   const mjrRect viewport{0, 0, width_px_, height_px_};
   prims_.clear();
   if (overlay_on_ && have_output_) {
+    // a served device's program is not this case's controller: its stylus
+    // and force only, not the case's mechanism
+    OverlayOptions oo;
+    oo.path = oo.mechanism = opt_.served == nullptr;
     overlay_primitives(overlay_controller_->mechanism(),
-                       overlay_controller_->params(), out_, OverlayOptions{},
-                       &prims_);
+                       overlay_controller_->params(), out_, oo, &prims_);
   }
   // the scene as `render` makes it (viz/scene_renderer.h)
   prepare_scene(m, d_render_, &vopt_, &cam_, prims_, &scn_);
@@ -208,8 +279,14 @@ void Viewer::render() {
 
   HudText t;
   t.case_name = case_name();
+  if (opt_.served != nullptr) t.case_name += " as " + opt_.served->spec();
   t.camera = camera_name_.empty() ? "free" : camera_name_;
-  t.hand = opt_.live ? opt_.live_name : (mouse_hand_ ? "mouse" : "script");
+  if (opt_.served != nullptr) {
+    t.hand = opt_.served->held() ? "mouse, holding the stylus"
+                                 : "mouse, let go (left-drag grabs)";
+  } else {
+    t.hand = opt_.live ? opt_.live_name : (mouse_hand_ ? "mouse" : "script");
+  }
   t.k_pos_N_per_mm = overlay_controller_->params().gains.k_pos_N_per_mm;
   t.k_ornt_Nmm_per_rad = overlay_controller_->params().gains.k_ornt_Nmm_per_rad;
   t.gain_scale = gain_scale_;
@@ -221,6 +298,8 @@ void Viewer::render() {
   t.frames_per_s = fps_;
   t.paused = paused();
   t.slow = slow_;
+  t.served = opt_.served != nullptr;
+  t.hand_force_N = hand_force_N_;
   hud_->draw(viewport, t, help_on_, &con_);
   if (want_shot_) {
     want_shot_ = false;
@@ -276,6 +355,7 @@ void Viewer::update_rates() {
 bool Viewer::frame() {
   Window::poll();
   if (want_close_ || win_->should_close()) return false;
+  if (opt_.stop_requested && opt_.stop_requested()) return false;
   copy_from_physics();
   render();
   win_->swap();

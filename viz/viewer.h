@@ -28,6 +28,10 @@
 #include "controller/controller.h"
 #include "viz/overlay.h"
 
+namespace vmh::sim {
+class ServedEmulator;
+}
+
 namespace vmh::viz {
 
 // A window cannot be opened (no display, no OpenGL): the message carries
@@ -66,6 +70,14 @@ struct ViewerOptions {
   // frame from the render thread; must not block
   std::function<LiveSample()> live;
   std::string live_name;          // shown in the text panel
+  // an emulator served to another process (`view --serve-hd`,
+  // sim/served_emulator.h): shown from its physics, the mouse its hand
+  // (left-drag grabs the stylus and moves it, release lets go). Not owned;
+  // started by the caller. The case list is then that one scene.
+  sim::ServedEmulator* served = nullptr;
+  // polled once a frame: true ends run() as closing the window does (the
+  // command line's SIGINT / SIGTERM, device/stop_signal.h)
+  std::function<bool()> stop_requested;
 };
 
 // An input event, in window coordinates (pixels, y down). Keys are GLFW key
@@ -152,6 +164,8 @@ class Viewer {
   void handle_button(const InputEvent& e);
   void handle_move(const InputEvent& e);
   void update_rates();
+  void copy_from_served();
+  void record_live_plot(double t_s);
 
   ViewerOptions opt_;
   int case_index_ = 0;
@@ -186,6 +200,7 @@ class Viewer {
   ControlOutput out_;
   double t_sim_s_ = 0.0;
   double d_path_mm_ = 0.0;
+  double hand_force_N_ = 0.0;  // served: the hand's force, N
   std::string status_;
   bool have_output_ = false;  // out_ is a controller's, not the default
   std::vector<OverlayPrimitive> prims_;

@@ -53,7 +53,13 @@ std::string status_text(ControlStatus s) {
   return out;
 }
 
-const char* hud_help_text() {
+const char* hud_help_text(bool served) {
+  if (served) {
+    return "left-drag grabs the stylus and moves it, shift+left-drag turns "
+           "it, release lets go\n"
+           "o overlay | c camera | p screenshot | h help | esc quit | "
+           "right-drag camera, middle-drag pan, scroll zoom";
+  }
   return "space pause | right arrow one tick | s slow x1/4 | r reset | "
          "[ ] case | + - gains x2 /2\n"
          "m mouse/script hand | o overlay | c camera | p screenshot | h help | "
@@ -73,6 +79,17 @@ Hud::Hud()
 }
 
 Hud::~Hud() = default;
+
+void Hud::set_served(bool served) {
+  // the hand's force in the colour of its spring line (viz/overlay.cc)
+  const float blue[3] = {0.45f, 0.65f, 0.95f};
+  const float brown[3] = {0.60f, 0.40f, 0.20f};
+  if (served) {
+    setup_figure(error_fig_.get(), "hand force (N)", brown);
+  } else {
+    setup_figure(error_fig_.get(), "path error (mm)", blue);
+  }
+}
 
 void Hud::set_samples(const PlotSample* samples, int n) {
   const float t_end = n > 0 ? samples[n - 1].t_s : 0.0f;
@@ -105,22 +122,34 @@ void Hud::set_samples(const PlotSample* samples, int n) {
 void Hud::draw(const mjrRect& viewport, const HudText& t, bool help,
                const mjrContext* con) {
   char values[1024];
-  std::snprintf(values, sizeof values,
-                "%s\n%s\n%s\n%.3g N/mm, %.4g N mm/rad (x%g)\n%.3f\n%.3f\n%s\n"
-                "%.3f%s\n%.2f\n%.1f",
-                t.case_name.c_str(), t.camera.c_str(), t.hand.c_str(),
-                t.k_pos_N_per_mm,
-                t.k_ornt_Nmm_per_rad, t.gain_scale, t.force_N,
-                t.path_error_mm, t.status.c_str(), t.t_sim_s,
-                t.paused ? "  (paused)" : (t.slow ? "  (x1/4)" : ""),
-                t.realtime_factor, t.frames_per_s);
-  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, viewport,
-              "case\ncamera\nhand\nK_pos, K_ornt\n|F| (N)\npath error (mm)\n"
-              "controller\nsim time (s)\nreal-time factor\nframes/s",
-              values, con);
+  if (t.served) {
+    std::snprintf(values, sizeof values,
+                  "%s\n%s\n%s\n%.3f\n%.3f\n%s\n%.3f\n%.2f\n%.1f",
+                  t.case_name.c_str(), t.camera.c_str(), t.hand.c_str(),
+                  t.force_N, t.hand_force_N, t.status.c_str(), t.t_sim_s,
+                  t.realtime_factor, t.frames_per_s);
+    mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, viewport,
+                "scene\ncamera\nhand\nclient |F| (N)\nhand |F| (N)\n"
+                "device\nsim time (s)\nreal-time factor\nframes/s",
+                values, con);
+  } else {
+    std::snprintf(values, sizeof values,
+                  "%s\n%s\n%s\n%.3g N/mm, %.4g N mm/rad (x%g)\n%.3f\n%.3f\n%s\n"
+                  "%.3f%s\n%.2f\n%.1f",
+                  t.case_name.c_str(), t.camera.c_str(), t.hand.c_str(),
+                  t.k_pos_N_per_mm,
+                  t.k_ornt_Nmm_per_rad, t.gain_scale, t.force_N,
+                  t.path_error_mm, t.status.c_str(), t.t_sim_s,
+                  t.paused ? "  (paused)" : (t.slow ? "  (x1/4)" : ""),
+                  t.realtime_factor, t.frames_per_s);
+    mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, viewport,
+                "case\ncamera\nhand\nK_pos, K_ornt\n|F| (N)\npath error (mm)\n"
+                "controller\nsim time (s)\nreal-time factor\nframes/s",
+                values, con);
+  }
   if (help) {
-    mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMLEFT, viewport, hud_help_text(),
-                nullptr, con);
+    mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMLEFT, viewport,
+                hud_help_text(t.served), nullptr, con);
   }
   // each plot a third of the width and at least 240 px high: MuJoCo's
   // labels take about 100 px of it

@@ -32,6 +32,11 @@ struct HudText {
   double frames_per_s = 0.0;
   bool paused = false;
   bool slow = false;
+  // a served emulator (view --serve-hd): a client program is the
+  // controller, so the panel shows the hand's force and the client's
+  // device instead of the case's gains and path error
+  bool served = false;
+  double hand_force_N = 0.0;  // served: what the mouse's hand exerts
 };
 
 // The top of a plot's axis from zero: the smallest step * intervals >= max,
@@ -40,8 +45,9 @@ struct HudText {
 // steps of 10 on 4 intervals). 1 for a max that is not a positive number.
 double round_axis_top(double max, int intervals);
 
-// The key help line (docs/viewer.md lists the same).
-const char* hud_help_text();
+// The key help line (docs/viewer.md lists the same); `served`: the keys
+// and the mouse of view --serve-hd.
+const char* hud_help_text(bool served = false);
 
 class Hud {
  public:
@@ -49,6 +55,9 @@ class Hud {
   ~Hud();
   // the plots' data: samples oldest first, the last kPlotWindow_s of them
   void set_samples(const PlotSample* samples, int n);
+  // served: the upper plot is the hand's force (PlotSample::d_path_mm
+  // then carries it, N), not the path error
+  void set_served(bool served);
   // draws the panel (top left), the help (bottom left, when `help`) and the
   // two plots (right) in `viewport`
   void draw(const mjrRect& viewport, const HudText& text, bool help,

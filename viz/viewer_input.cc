@@ -8,9 +8,24 @@
 
 #include "viz/mouse_hand.h"
 #include "viz/viewer.h"
+#include "sim/served_emulator.h"
 #include "viz/viewer_physics.h"
 
 namespace vmh::viz {
+namespace {
+
+// the viewer's free camera as the mouse-hand geometry takes it
+ViewCamera view_camera_of(const mjvCamera& c, const mjModel* m) {
+  ViewCamera cam;
+  cam.lookat_m = Vec3(c.lookat[0], c.lookat[1], c.lookat[2]);
+  cam.azimuth_deg = c.azimuth;
+  cam.elevation_deg = c.elevation;
+  cam.distance_m = c.distance;
+  cam.fovy_deg = m->vis.global.fovy;
+  return cam;
+}
+
+}  // namespace
 
 InputEvent InputEvent::key_press(int key, bool shift) {
   InputEvent e;
@@ -62,7 +77,8 @@ void Viewer::inject(const InputEvent& e) {
 }
 
 void Viewer::handle_key(const InputEvent& e) {
-  const bool sim_only = !opt_.live;  // a device runs on its own
+  // a device runs on its own, and so does a served emulator
+  const bool sim_only = !opt_.live && opt_.served == nullptr;
   switch (e.key) {
     case GLFW_KEY_ESCAPE:
     case GLFW_KEY_Q:
@@ -146,6 +162,20 @@ void Viewer::handle_button(const InputEvent& e) {
   if (e.button == GLFW_MOUSE_BUTTON_MIDDLE) middle_down_ = e.press;
   // the modifier is read when the drag starts: a drag is a move or a turn
   if (e.press && e.button == GLFW_MOUSE_BUTTON_LEFT) drag_rotate_ = e.shift;
+  if (opt_.served != nullptr && e.button == GLFW_MOUSE_BUTTON_LEFT) {
+    // the hand takes the stylus where it is (the grip site of the last
+    // frame's copy), so nothing jumps; releasing the button lets go
+    if (e.press && d_render_ != nullptr) {
+      const int g = opt_.served->loop().hand().grip_site();
+      sim::HandTargetState t;
+      t.p_m = Vec3(d_render_->site_xpos + 3 * g);
+      t.R = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+          d_render_->site_xmat + 9 * g);
+      opt_.served->grab(t);
+    } else if (!e.press) {
+      opt_.served->release();
+    }
+  }
   last_x_px_ = e.x_px;
   last_y_px_ = e.y_px;
 }
@@ -158,15 +188,15 @@ void Viewer::handle_move(const InputEvent& e) {
   if (dx == 0.0 && dy == 0.0) return;
   // drags are in window coordinates, which a HiDPI framebuffer scales
   const int h = win_height_px_ > 0 ? win_height_px_ : opt_.height_px;
+  if (left_down_ && opt_.served != nullptr) {
+    sim::HandTargetState t = opt_.served->target();
+    apply_drag(view_camera_of(cam_, model()), h, dx, dy, drag_rotate_, &t);
+    opt_.served->set_target(t);
+    return;
+  }
   if (left_down_ && mouse_hand_ && !opt_.live) {
-    ViewCamera cam;
-    cam.lookat_m = Vec3(cam_.lookat[0], cam_.lookat[1], cam_.lookat[2]);
-    cam.azimuth_deg = cam_.azimuth;
-    cam.elevation_deg = cam_.elevation;
-    cam.distance_m = cam_.distance;
-    cam.fovy_deg = model()->vis.global.fovy;
     sim::HandTargetState t = sim_->manual_target();
-    apply_drag(cam, h, dx, dy, drag_rotate_, &t);
+    apply_drag(view_camera_of(cam_, model()), h, dx, dy, drag_rotate_, &t);
     sim_->set_manual_target(t);
     return;
   }

@@ -3,9 +3,12 @@
 // without a display it says so.
 #include <gtest/gtest.h>
 
-#include <cstdio>
-#include <string>
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
 
 namespace {
 
@@ -56,6 +59,34 @@ TEST(ViewCli, NoDisplayIsExit1NamingIt) {
             std::string::npos) << r.err;
   EXPECT_NE(r.err.find("DISPLAY"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
+}
+
+// view --serve-hd: the emulator served under a name while the window
+// runs, the name gone once it has closed (a client's test is
+// tests/hd/hd_served_test.cc, the window's tests/viz/viewer_served_test.cc)
+TEST(ViewCli, ServeHdServesWhileOpenAndRemovesItsName) {
+  const std::string name = "cli-" + std::to_string(::getpid());
+  const Result r = run("view --serve-hd " + name +
+                       " --frames 10 --width 320 --height 240");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("as served:" + name), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("VMH_HD_DEVICE=served:" + name), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists("/dev/shm/vmhaptics-hd-" + name));
+}
+
+TEST(ViewCli, ServeHdRefusesABadNameAndADevice) {
+  Result r = run("view --serve-hd a/b --frames 3");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("letters, digits"), std::string::npos) << r.err;
+  r = run("view case1 --serve-hd ok --device emulator --frames 3");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("not with --device"), std::string::npos) << r.err;
+  // no window: exit 1, and the name was not left behind
+  const std::string name = "nodisplay-" + std::to_string(::getpid());
+  r = run("view --serve-hd " + name + " --frames 3",
+          "env -u DISPLAY -u WAYLAND_DISPLAY ");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists("/dev/shm/vmhaptics-hd-" + name));
 }
 
 }  // namespace
