@@ -630,8 +630,13 @@ HDAPI HDstring HDAPIENTRY hdGetString(HDenum p) {
   HdDevice* d = current_device();
   if (d == nullptr) return nullptr;
   const vmh::DeviceIdentity& id = d->identity();
-  // kept alive with the device; rewritten only here, off the servo thread
-  static thread_local std::string s;
+  // one buffer per device and string, so that strings fetched one after
+  // the other are all still valid (a program prints several in one
+  // printf); rewritten only here, with the same text each time
+  static thread_local std::string kept[kMaxDevices][HD_DEVICE_FIRMWARE_VERSION -
+                                                    HD_VERSION + 1];
+  const bool is_string = p >= HD_VERSION && p <= HD_DEVICE_FIRMWARE_VERSION;
+  std::string& s = kept[current_handle()][is_string ? p - HD_VERSION : 0];
   switch (p) {
     case HD_VERSION: return "3.0.0 (vmhaptics open HD API)";
     case HD_DEVICE_MODEL_TYPE:
