@@ -85,6 +85,7 @@ int detail_slot(HDerror code) {
     case HD_TIMER_ERROR: return 3;
     case HD_DEVICE_ALREADY_INITIATED: return 4;
     case HD_INVALID_VALUE: return 5;
+    case HD_INVALID_OPERATION: return 6;
     default: return -1;
   }
 }
@@ -305,7 +306,7 @@ HDAPI HHD HDAPIENTRY hdInitDevice(HDstring config_name) {
   }
   std::lock_guard<std::mutex> lock(c.mu);
   if (c.running.load()) {
-    set_detail(HD_INVALID_VALUE, "hdInitDevice(\"" + shown +
+    set_detail(HD_INVALID_OPERATION, "hdInitDevice(\"" + shown +
                                      "\"): stop the scheduler before opening "
                                      "another device");
     push_error(HD_INVALID_OPERATION, kInternalNone, HD_INVALID_HANDLE);

@@ -221,6 +221,10 @@ int main(void) {
   HHD again = hdInitDevice("Left");
   CHECK(again == HD_INVALID_HANDLE, "no device opened while the scheduler runs");
   CHECK(pop_errors() == HD_INVALID_OPERATION, "opening while running");
+  const char* why = hdGetErrorString(HD_INVALID_OPERATION);
+  CHECK(why != NULL && strstr(why, "hdInitDevice(\"Left\")") &&
+            strstr(why, "stop the scheduler"),
+        "the cause under the code raised: %s", why ? why : "(null)");
   hdStopScheduler();
   again = hdInitDevice("Left");
   CHECK(again != HD_INVALID_HANDLE, "Left again: %s",
