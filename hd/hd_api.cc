@@ -293,32 +293,33 @@ HDAPI HHD HDAPIENTRY hdInitDevice(HDstring config_name) {
   Context& c = ctx();
   const std::string shown = config_name == nullptr ? "HD_DEFAULT_DEVICE"
                                                     : std::string(config_name);
+  // a refusal: its cause, after the call as the program made it, kept for
+  // hdGetErrorString (and printed), its code on the error stack
+  const auto refuse = [&shown](HDerror code, int internal, HHD h,
+                               const std::string& cause) -> HHD {
+    set_detail(code, "hdInitDevice(\"" + shown + "\")" + cause);
+    push_error(code, internal, h);
+    return HD_INVALID_HANDLE;
+  };
   std::string spec;
   try {
     spec = resolve_device_name(load_hd_config(), config_name);
   } catch (const HdConfigError& e) {
     const bool file = std::string(e.what()).rfind("no device is configured", 0) != 0;
-    set_detail(HD_COMM_CONFIG_ERROR, "hdInitDevice(\"" + shown + "\"): " + e.what());
-    push_error(HD_COMM_CONFIG_ERROR,
-               file ? kInternalConfigFile : kInternalNameNotConfigured,
-               HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_COMM_CONFIG_ERROR,
+                  file ? kInternalConfigFile : kInternalNameNotConfigured,
+                  HD_INVALID_HANDLE, std::string(": ") + e.what());
   }
   std::lock_guard<std::mutex> lock(c.mu);
   if (c.running.load()) {
-    set_detail(HD_INVALID_OPERATION, "hdInitDevice(\"" + shown +
-                                     "\"): stop the scheduler before opening "
-                                     "another device");
-    push_error(HD_INVALID_OPERATION, kInternalNone, HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_INVALID_OPERATION, kInternalNone, HD_INVALID_HANDLE,
+                  ": stop the scheduler before opening another device");
   }
   for (HHD h = 0; h < static_cast<HHD>(kMaxDevices); ++h) {
     if (c.devices[h] && c.devices[h]->spec() == spec) {
-      set_detail(HD_DEVICE_ALREADY_INITIATED,
-                 "hdInitDevice(\"" + shown + "\"): '" + spec +
-                     "' is already open as handle " + std::to_string(h));
-      push_error(HD_DEVICE_ALREADY_INITIATED, kInternalNone, h);
-      return HD_INVALID_HANDLE;
+      return refuse(HD_DEVICE_ALREADY_INITIATED, kInternalNone, h,
+                    ": '" + spec + "' is already open as handle " +
+                        std::to_string(h));
     }
   }
   HHD slot = HD_INVALID_HANDLE;
@@ -329,34 +330,26 @@ HDAPI HHD HDAPIENTRY hdInitDevice(HDstring config_name) {
     }
   }
   if (slot == HD_INVALID_HANDLE) {
-    set_detail(HD_COMM_CONFIG_ERROR, "hdInitDevice(\"" + shown + "\"): " +
-                                         std::to_string(kMaxDevices) +
-                                         " devices are open already");
-    push_error(HD_COMM_CONFIG_ERROR, kInternalTooManyDevices, HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_COMM_CONFIG_ERROR, kInternalTooManyDevices, HD_INVALID_HANDLE,
+                  ": " + std::to_string(kMaxDevices) + " devices are open already");
   }
+  const std::string opening = " -> '" + spec + "': ";
   const bool lockstep = parse_lockstep();
   try {
     c.devices[slot] = std::make_unique<HdDevice>(library_registry(), spec, lockstep);
   } catch (const vmh::DeviceOpenError& e) {
-    set_detail(HD_COMM_CONFIG_ERROR,
-               "hdInitDevice(\"" + shown + "\") -> '" + spec + "': " + e.what());
-    push_error(HD_COMM_CONFIG_ERROR, kInternalDeviceNotFound, HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_COMM_CONFIG_ERROR, kInternalDeviceNotFound, HD_INVALID_HANDLE,
+                  opening + e.what());
   } catch (const std::exception& e) {
-    set_detail(HD_COMM_CONFIG_ERROR,
-               "hdInitDevice(\"" + shown + "\") -> '" + spec + "': " + e.what());
-    push_error(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE,
+                  opening + e.what());
   }
   if (lockstep && !c.devices[slot]->simulated()) {
     c.devices[slot].reset();
-    set_detail(HD_COMM_CONFIG_ERROR,
-               "hdInitDevice(\"" + shown + "\") -> '" + spec +
-                   "': VMH_HD_CLOCK=lockstep needs a simulated device "
-                   "(emulator...); a real device runs on the wall clock");
-    push_error(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE,
+                  opening +
+                      "VMH_HD_CLOCK=lockstep needs a simulated device "
+                      "(emulator...); a real device runs on the wall clock");
   }
   c.lockstep.store(lockstep);
   c.live[slot].store(c.devices[slot].get(), std::memory_order_release);
