@@ -696,8 +696,9 @@ void set_numbers(HDenum p, const T* params) {
                        p == HD_CURRENT_MOTOR_DAC_VALUES;
   if (!command) {
     double v[36];
-    push_error(read_numbers(d, p, v) > 0 ? HD_INVALID_OPERATION : HD_INVALID_ENUM,
-               read_numbers(d, p, v) > 0 ? kInternalReadOnly : kInternalUnknownParameter,
+    const bool readable = read_numbers(d, p, v) > 0;
+    push_error(readable ? HD_INVALID_OPERATION : HD_INVALID_ENUM,
+               readable ? kInternalReadOnly : kInternalUnknownParameter,
                current_handle());
     return;
   }
