@@ -53,7 +53,8 @@ enum Internal : int {
   kInternalFrameState = 8,
   kInternalReadOnly = 9,
   kInternalUnknownParameter = 10,
-  kInternalNoFrame = 11,
+  // 11 is not used: every state call is answered outside a frame too (the
+  // last published tick), so none raises HD_FRAME_ERROR
   kInternalSafety = 12,
 };
 
