@@ -53,7 +53,8 @@ enum Internal : int {
   kInternalFrameState = 8,
   kInternalReadOnly = 9,
   kInternalUnknownParameter = 10,
-  kInternalNoFrame = 11,
+  // 11 is not used: every state call is answered outside a frame too (the
+  // last published tick), so none raises HD_FRAME_ERROR
   kInternalSafety = 12,
 };
 
@@ -85,6 +86,7 @@ int detail_slot(HDerror code) {
     case HD_TIMER_ERROR: return 3;
     case HD_DEVICE_ALREADY_INITIATED: return 4;
     case HD_INVALID_VALUE: return 5;
+    case HD_INVALID_OPERATION: return 6;
     default: return -1;
   }
 }
@@ -292,32 +294,33 @@ HDAPI HHD HDAPIENTRY hdInitDevice(HDstring config_name) {
   Context& c = ctx();
   const std::string shown = config_name == nullptr ? "HD_DEFAULT_DEVICE"
                                                     : std::string(config_name);
+  // a refusal: its cause, after the call as the program made it, kept for
+  // hdGetErrorString (and printed), its code on the error stack
+  const auto refuse = [&shown](HDerror code, int internal, HHD h,
+                               const std::string& cause) -> HHD {
+    set_detail(code, "hdInitDevice(\"" + shown + "\")" + cause);
+    push_error(code, internal, h);
+    return HD_INVALID_HANDLE;
+  };
   std::string spec;
   try {
     spec = resolve_device_name(load_hd_config(), config_name);
   } catch (const HdConfigError& e) {
     const bool file = std::string(e.what()).rfind("no device is configured", 0) != 0;
-    set_detail(HD_COMM_CONFIG_ERROR, "hdInitDevice(\"" + shown + "\"): " + e.what());
-    push_error(HD_COMM_CONFIG_ERROR,
-               file ? kInternalConfigFile : kInternalNameNotConfigured,
-               HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_COMM_CONFIG_ERROR,
+                  file ? kInternalConfigFile : kInternalNameNotConfigured,
+                  HD_INVALID_HANDLE, std::string(": ") + e.what());
   }
   std::lock_guard<std::mutex> lock(c.mu);
   if (c.running.load()) {
-    set_detail(HD_INVALID_VALUE, "hdInitDevice(\"" + shown +
-                                     "\"): stop the scheduler before opening "
-                                     "another device");
-    push_error(HD_INVALID_OPERATION, kInternalNone, HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_INVALID_OPERATION, kInternalNone, HD_INVALID_HANDLE,
+                  ": stop the scheduler before opening another device");
   }
   for (HHD h = 0; h < static_cast<HHD>(kMaxDevices); ++h) {
     if (c.devices[h] && c.devices[h]->spec() == spec) {
-      set_detail(HD_DEVICE_ALREADY_INITIATED,
-                 "hdInitDevice(\"" + shown + "\"): '" + spec +
-                     "' is already open as handle " + std::to_string(h));
-      push_error(HD_DEVICE_ALREADY_INITIATED, kInternalNone, h);
-      return HD_INVALID_HANDLE;
+      return refuse(HD_DEVICE_ALREADY_INITIATED, kInternalNone, h,
+                    ": '" + spec + "' is already open as handle " +
+                        std::to_string(h));
     }
   }
   HHD slot = HD_INVALID_HANDLE;
@@ -328,34 +331,26 @@ HDAPI HHD HDAPIENTRY hdInitDevice(HDstring config_name) {
     }
   }
   if (slot == HD_INVALID_HANDLE) {
-    set_detail(HD_COMM_CONFIG_ERROR, "hdInitDevice(\"" + shown + "\"): " +
-                                         std::to_string(kMaxDevices) +
-                                         " devices are open already");
-    push_error(HD_COMM_CONFIG_ERROR, kInternalTooManyDevices, HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_COMM_CONFIG_ERROR, kInternalTooManyDevices, HD_INVALID_HANDLE,
+                  ": " + std::to_string(kMaxDevices) + " devices are open already");
   }
+  const std::string opening = " -> '" + spec + "': ";
   const bool lockstep = parse_lockstep();
   try {
     c.devices[slot] = std::make_unique<HdDevice>(library_registry(), spec, lockstep);
   } catch (const vmh::DeviceOpenError& e) {
-    set_detail(HD_COMM_CONFIG_ERROR,
-               "hdInitDevice(\"" + shown + "\") -> '" + spec + "': " + e.what());
-    push_error(HD_COMM_CONFIG_ERROR, kInternalDeviceNotFound, HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_COMM_CONFIG_ERROR, kInternalDeviceNotFound, HD_INVALID_HANDLE,
+                  opening + e.what());
   } catch (const std::exception& e) {
-    set_detail(HD_COMM_CONFIG_ERROR,
-               "hdInitDevice(\"" + shown + "\") -> '" + spec + "': " + e.what());
-    push_error(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE,
+                  opening + e.what());
   }
   if (lockstep && !c.devices[slot]->simulated()) {
     c.devices[slot].reset();
-    set_detail(HD_COMM_CONFIG_ERROR,
-               "hdInitDevice(\"" + shown + "\") -> '" + spec +
-                   "': VMH_HD_CLOCK=lockstep needs a simulated device "
-                   "(emulator...); a real device runs on the wall clock");
-    push_error(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE);
-    return HD_INVALID_HANDLE;
+    return refuse(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE,
+                  opening +
+                      "VMH_HD_CLOCK=lockstep needs a simulated device "
+                      "(emulator...); a real device runs on the wall clock");
   }
   c.lockstep.store(lockstep);
   c.live[slot].store(c.devices[slot].get(), std::memory_order_release);
@@ -630,8 +625,13 @@ HDAPI HDstring HDAPIENTRY hdGetString(HDenum p) {
   HdDevice* d = current_device();
   if (d == nullptr) return nullptr;
   const vmh::DeviceIdentity& id = d->identity();
-  // kept alive with the device; rewritten only here, off the servo thread
-  static thread_local std::string s;
+  // one buffer per device and string, so that strings fetched one after
+  // the other are all still valid (a program prints several in one
+  // printf); rewritten only here, with the same text each time
+  static thread_local std::string kept[kMaxDevices][HD_DEVICE_FIRMWARE_VERSION -
+                                                    HD_VERSION + 1];
+  const bool is_string = p >= HD_VERSION && p <= HD_DEVICE_FIRMWARE_VERSION;
+  std::string& s = kept[current_handle()][is_string ? p - HD_VERSION : 0];
   switch (p) {
     case HD_VERSION: return "3.0.0 (vmhaptics open HD API)";
     case HD_DEVICE_MODEL_TYPE:
@@ -697,8 +697,9 @@ void set_numbers(HDenum p, const T* params) {
                        p == HD_CURRENT_MOTOR_DAC_VALUES;
   if (!command) {
     double v[36];
-    push_error(read_numbers(d, p, v) > 0 ? HD_INVALID_OPERATION : HD_INVALID_ENUM,
-               read_numbers(d, p, v) > 0 ? kInternalReadOnly : kInternalUnknownParameter,
+    const bool readable = read_numbers(d, p, v) > 0;
+    push_error(readable ? HD_INVALID_OPERATION : HD_INVALID_ENUM,
+               readable ? kInternalReadOnly : kInternalUnknownParameter,
                current_handle());
     return;
   }

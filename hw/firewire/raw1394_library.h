@@ -19,6 +19,7 @@
 #include <memory>
 #include <string>
 
+#include "hw/dl_library.h"
 #include "hw/firewire/raw1394_api.h"
 
 namespace vmh::hw::fw {
@@ -34,13 +35,12 @@ class Raw1394Library {
   // was looked for and the loader's reason, or the missing symbol.
   static std::shared_ptr<const Raw1394Library> load(const std::string& file = {});
 
-  ~Raw1394Library();
   Raw1394Library(const Raw1394Library&) = delete;
   Raw1394Library& operator=(const Raw1394Library&) = delete;
 
   const r1394::Api& api() const noexcept { return api_; }
   // what was loaded: VMH_LIBRAW1394's value or the default name
-  const std::string& file() const noexcept { return file_; }
+  const std::string& file() const noexcept { return dl_.file(); }
   // a symbol of the library beyond the API (a test library's own), or null
   void* symbol(const char* name) const noexcept;
 
@@ -48,9 +48,8 @@ class Raw1394Library {
   static std::string describe_search();
 
  private:
-  Raw1394Library() = default;
-  void* handle_ = nullptr;
-  std::string file_;
+  explicit Raw1394Library(const DlChoice& choice);
+  DlLibrary dl_;
   r1394::Api api_{};
 };
 

@@ -9,6 +9,7 @@
 
 #include <string>
 
+#include "hw/dl_library.h"
 #include "hw/openhaptics/hd_api.h"
 
 namespace vmh::hw::hd {
@@ -25,20 +26,18 @@ class HdLibrary {
   // Loads `file`: a path (it contains '/') or a bare name for the loader to
   // search for.
   explicit HdLibrary(const std::string& file);
-  ~HdLibrary();
   HdLibrary(const HdLibrary&) = delete;
   HdLibrary& operator=(const HdLibrary&) = delete;
 
   const HdApi& api() const noexcept { return api_; }
   // what was loaded: VMH_LIBHD's value or "libHD.so"
-  const std::string& file() const noexcept { return file_; }
+  const std::string& file() const noexcept { return dl_.file(); }
 
   // One line for `hw list`: what a load would try now.
   static std::string describe_search();
 
  private:
-  void* handle_ = nullptr;
-  std::string file_;
+  DlLibrary dl_;
   HdApi api_;
 };
 
