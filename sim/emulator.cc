@@ -251,22 +251,25 @@ void Emulator::inject(const EmulatorFault& fault) {
   slot.ready.store(true, std::memory_order_release);
 }
 
-void Emulator::start() {
+void Emulator::start(bool resume) {
   if (running_.load()) throw DeviceOpenError("emulator: already running");
   if (thread_.joinable()) thread_.join();
-  // a fresh run: the start pose, at rest, emulator time 0; faults given
-  // before now keep their times from this start
-  loop_->reset();
-  ps_ = std::make_unique<PhysicsState>(loop_.get());
+  stop_.store(false);
   drops_.store(0);
   unplugged_.store(false);
-  t_sim_now_s_.store(0.0);
-  stop_.store(false);
-  lockstep_periods_.store(0);
   frozen_until_s_ = -1.0;
   starved_reads_.store(0);
-  // the start's truth: the state at rest, before any period
-  ps_->q_start_dh = loop_->device().true_q_dh();
+  if (!resume || !started_before_) {
+    // a fresh run: the start pose, at rest, emulator time 0; faults given
+    // before now keep their times from this start
+    loop_->reset();
+    ps_ = std::make_unique<PhysicsState>(loop_.get());
+    t_sim_now_s_.store(0.0);
+    lockstep_periods_.store(0);
+    // the start's truth: the state at rest, before any period
+    ps_->q_start_dh = loop_->device().true_q_dh();
+  }
+  started_before_ = true;
   publish(clock_s());
   running_.store(true);
   if (options_.lockstep) return;  // advance() runs the periods

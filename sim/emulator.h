@@ -273,9 +273,12 @@ class Emulator final : public HapticDevice {
   Emulator& operator=(const Emulator&) = delete;
 
   // Launches the physics thread (emulator time 0); in lockstep, only
-  // resets to time 0. Throws DeviceOpenError if it is already running or
-  // cannot be started.
-  void start();
+  // resets to time 0. With `resume`, an emulator that has run before goes
+  // on from where stop() left it (pose, velocities, emulator time, the
+  // periods and energies counted), as a device does when its host's loop
+  // is restarted; its first start is fresh either way. Throws
+  // DeviceOpenError if it is already running or cannot be started.
+  void start(bool resume = false);
   // lockstep only: one servo period (the last command held), then the
   // clock moves on by the period. No allocation, no exception, no sleep.
   void advance() noexcept;
@@ -384,6 +387,7 @@ class Emulator final : public HapticDevice {
 
   std::thread thread_;
   std::atomic<bool> running_{false};
+  bool started_before_ = false;  // start(resume) goes on from here
   std::atomic<bool> stop_{false};
 
   // shared with the servo thread and others

@@ -84,7 +84,10 @@ class EmulatorBackend final : public DeviceBackend {
           std::string(emu_.lockstep() ? "lockstep" : "wall") +
           " clock, started on the other");
     }
-    emu_.start();
+    // a restarted loop (an HD program's hdStopScheduler, hdStartScheduler,
+    // or the scheduler's restart when another device leaves) finds the
+    // stylus where it was, as a real device's would be
+    emu_.start(/*resume=*/true);
     if (options.lockstep) {
       lockstep_.start(loop, &plant_);
       ServoReport r;

@@ -198,7 +198,9 @@ void EmulatorFirewireTransport::start() {
   taken_.fill(false);
   taken_count_ = 0;
   reset_pending_.store(false);
-  emu_->start();
+  // the arm stays where it was when the stream restarts (the emulator's
+  // first start is fresh)
+  emu_->start(/*resume=*/true);
   // the emulator's clock (lockstep: its periods) is the packets' time base
   start_wall_s_ = emu_->clock_s();
 }
