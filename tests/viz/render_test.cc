@@ -354,7 +354,8 @@ TEST(SceneRenderer, EveryNamedCameraFramesTheWholeLitDevice) {
         }
       }
       const double share = static_cast<double>(device) / (w * h);
-      const double mean_lum = device > 0 ? luminance / device : 0.0;
+      const double mean_lum =
+          device > 0 ? luminance / static_cast<double>(device) : 0.0;
       std::cout << "camera " << cam << " " << w << "x" << h
                 << ": device share " << share << ", mean luminance "
                 << mean_lum << "\n";
