@@ -348,12 +348,13 @@ HDAPI HHD HDAPIENTRY hdInitDevice(HDstring config_name) {
     push_error(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE);
     return HD_INVALID_HANDLE;
   }
-  if (lockstep && !c.devices[slot]->simulated()) {
+  if (lockstep && !c.devices[slot]->can_lockstep()) {
     c.devices[slot].reset();
     set_detail(HD_COMM_CONFIG_ERROR,
                "hdInitDevice(\"" + shown + "\") -> '" + spec +
                    "': VMH_HD_CLOCK=lockstep needs a simulated device "
-                   "(emulator...); a real device runs on the wall clock");
+                   "(emulator...) or a recording (replay:DIR); a real "
+                   "device runs on the wall clock");
     push_error(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE);
     return HD_INVALID_HANDLE;
   }
