@@ -2,6 +2,7 @@
 
 #include "hw/firewire/firewire_runtime.h"
 #include "hw/openhaptics/openhaptics_runtime.h"
+#include "hw/replay/replay_runtime.h"
 #include "hw/usb/usb_runtime.h"
 
 namespace vmh::hw {
@@ -10,6 +11,7 @@ void register_backends(runtime::BackendRegistry* registry) {
   register_openhaptics_backend(registry);
   fw::register_firewire_backend(registry);
   usb::register_usb_backend(registry);
+  replay::register_replay_backend(registry);
 }
 
 }  // namespace vmh::hw

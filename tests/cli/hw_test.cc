@@ -75,8 +75,13 @@ TEST(HwCli, ListNamesEveryBackendAndWhyNot) {
   }
   // each backend as it registered: hw/'s (hw/backends.cc), then sim/'s
   EXPECT_EQ(names, (std::vector<std::string>{"openhaptics", "firewire", "usb",
-                                             "emulator", "emulator:firewire"}));
-  EXPECT_TRUE(j["backends"][3]["available"].get<bool>());
+                                             "replay", "emulator",
+                                             "emulator:firewire"}));
+  EXPECT_TRUE(j["backends"][4]["available"].get<bool>());
+  // a recording has no discovery: the row says what to give instead
+  EXPECT_NE(j["backends"][3]["why_not"].get<std::string>().find(
+                "give a recording folder"),
+            std::string::npos);
 }
 
 TEST(HwCli, ListSaysWhichLibHDItLookedFor) {
