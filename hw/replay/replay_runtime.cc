@@ -94,11 +94,11 @@ void register_replay_backend(runtime::BackendRegistry* registry) {
   b.summary = "a recording of `hw record` (DIR/trace.csv) served as a device";
   b.options = {
       {"replay-end",
-       "replay: after the recording's last row, hold (keep serving it; "
+       "after the recording's last row, hold (keep serving it; "
        "default), loop (from the first row again) or stop (reads fail: the "
        "device is gone)"},
       {"replay-speed",
-       "replay: recording seconds per second of replay, > 0 and <= 1000 "
+       "recording seconds per second of replay, > 0 and <= 1000 "
        "(default 1)"},
   };
   b.lockstep = true;

@@ -360,7 +360,12 @@ TEST(ReplayDeviceRealtime, WallClockServesRowsInOrder) {
   ServoOptions so;
   so.realtime = false;
   b.start(&loop, so);
+  // a few ticks, however long a busy host makes them take
   std::this_thread::sleep_for(std::chrono::milliseconds(60));
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (b.replay()->stats().reads < 5 && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   b.stop();
   ASSERT_GE(loop.q.size(), 1u);
   int last = -1;
