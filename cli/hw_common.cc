@@ -39,8 +39,8 @@ void add_hw_common(CLI::App* cmd, HwCommon* c) {
                   "realtime (the wall clock: a servo thread, as on a device) "
                   "or lockstep (one period of simulated physics per tick, on "
                   "one thread: deterministic, as fast as the machine allows; "
-                  "simulated devices only). Default: lockstep for a simulated "
-                  "device, realtime otherwise")
+                  "simulated devices and replay:DIR only). Default: lockstep "
+                  "for a simulated device, realtime otherwise")
       ->check(CLI::IsMember({"realtime", "lockstep"}));
   cmd->add_flag("--no-realtime", c->no_realtime,
                 "do not ask for SCHED_FIFO and mlockall");
@@ -65,9 +65,10 @@ const runtime::BackendInfo& hw_backend(const HwCommon& c, std::string* argument)
 bool hw_lockstep(const HwCommon& c) {
   std::string argument;
   const runtime::BackendInfo& b = hw_backend(c, &argument);
-  if (c.clock == "lockstep" && !b.simulated) {
-    throw UsageError("--clock lockstep: only a simulated device runs in "
-                     "lockstep, not --device " + c.device);
+  if (c.clock == "lockstep" && !b.can_lockstep()) {
+    throw UsageError("--clock lockstep: only a simulated device or a "
+                     "recording (replay:DIR) runs in lockstep, not --device " +
+                     c.device);
   }
   if (c.clock.empty()) return b.simulated;
   return c.clock == "lockstep";

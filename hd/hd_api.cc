@@ -345,12 +345,13 @@ HDAPI HHD HDAPIENTRY hdInitDevice(HDstring config_name) {
     return refuse(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE,
                   opening + e.what());
   }
-  if (lockstep && !c.devices[slot]->simulated()) {
+  if (lockstep && !c.devices[slot]->can_lockstep()) {
     c.devices[slot].reset();
     return refuse(HD_COMM_CONFIG_ERROR, kInternalBackendRefused, HD_INVALID_HANDLE,
                   opening +
                       "VMH_HD_CLOCK=lockstep needs a simulated device "
-                      "(emulator...); a real device runs on the wall clock");
+                      "(emulator...) or a recording (replay:DIR); a real "
+                      "device runs on the wall clock");
   }
   c.lockstep.store(lockstep);
   c.live[slot].store(c.devices[slot].get(), std::memory_order_release);

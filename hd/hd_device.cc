@@ -54,8 +54,8 @@ HdDevice::HdDevice(const runtime::BackendRegistry& registry,
   }
   // a simulated stylus that nothing holds: the program's forces move it
   rq.defaults["hand"] = "none";
-  rq.lockstep = lockstep && info.simulated;
-  simulated_ = info.simulated;
+  rq.lockstep = lockstep && info.can_lockstep();
+  can_lockstep_ = info.can_lockstep();
   opened_ = registry.open(
       info.name + (rq.argument.empty() ? "" : ":" + rq.argument), rq,
       /*servo=*/true);

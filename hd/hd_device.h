@@ -105,7 +105,8 @@ class HdDevice {
   DeviceBackend* backend() { return opened_.backend.get(); }
   const runtime::OpenedDevice& opened() const { return opened_; }
   HdSettings& settings() { return settings_; }
-  bool simulated() const { return simulated_; }
+  // the backend runs in lockstep (a simulated plant, a replay)
+  bool can_lockstep() const { return can_lockstep_; }
   // the box the wrist centre reaches over the arm's joint ranges (device
   // frame, mm: min x, y, z, max x, y, z), from the kinematics: no data
   // sheet gives HD_MAX_WORKSPACE_DIMENSIONS for the Omni
@@ -142,7 +143,7 @@ class HdDevice {
   std::string spec_;
   runtime::OpenedDevice opened_;
   DeviceIdentity identity_;
-  bool simulated_ = false;
+  bool can_lockstep_ = false;
   OmniParams omni_;
   double max_workspace_mm_[6] = {0, 0, 0, 0, 0, 0};
   HdSettings settings_;

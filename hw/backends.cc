@@ -3,6 +3,7 @@
 #include "hw/firewire/firewire_runtime.h"
 #include "hw/openhaptics/openhaptics_runtime.h"
 #include "hw/served/served_runtime.h"
+#include "hw/replay/replay_runtime.h"
 #include "hw/usb/usb_runtime.h"
 
 namespace vmh::hw {
@@ -12,6 +13,7 @@ void register_backends(runtime::BackendRegistry* registry) {
   fw::register_firewire_backend(registry);
   usb::register_usb_backend(registry);
   served::register_served_backend(registry);
+  replay::register_replay_backend(registry);
 }
 
 }  // namespace vmh::hw

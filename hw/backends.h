@@ -8,7 +8,7 @@
 
 namespace vmh::hw {
 
-// openhaptics, firewire, usb, served
+// openhaptics, firewire, usb, served, replay
 void register_backends(runtime::BackendRegistry* registry);
 
 }  // namespace vmh::hw

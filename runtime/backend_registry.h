@@ -5,7 +5,7 @@
 // by name.
 //
 // Who registers what (one line each):
-//   hw/backends.cc        openhaptics, firewire, usb, served (no MuJoCo)
+//   hw/backends.cc        openhaptics, firewire, usb, served, replay (no MuJoCo)
 //   sim/emulator_backend  emulator, emulator:firewire       (MuJoCo)
 // The command line calls hw::register_backends() and, where the build has
 // the testbed, sim::register_backends() before it parses.
@@ -107,8 +107,8 @@ struct OpenRequest {
   // load the stored calibration for the device's serial number
   bool load_calibration = true;
   // the session will run in lockstep (ServoOptions::lockstep): a simulated
-  // plant is built for it (no physics thread); others ignore it and refuse
-  // a lockstep start
+  // plant is built for it (no physics thread), a replay steps its clock
+  // with the ticks; others ignore it and refuse a lockstep start
   bool lockstep = false;
 
   // the option `key` as given, else its default, else ""
@@ -132,6 +132,11 @@ struct BackendInfo {
   // a simulated plant: takes a scene as its argument, can run in lockstep,
   // has a truth
   bool simulated = false;
+  // runs in lockstep though not simulated (a recording played back on the
+  // loop's clock, hw/replay/): OpenRequest::lockstep is honoured. A
+  // simulated backend runs in lockstep whatever this says.
+  bool lockstep = false;
+  bool can_lockstep() const { return simulated || lockstep; }
   // `hw list`'s fields for this backend beyond name and device:
   // "available", "found" or "why_not", anything else it knows. Never
   // throws: a failure is a why_not.

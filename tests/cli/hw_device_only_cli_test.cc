@@ -29,7 +29,9 @@ TEST(DeviceOnlyCli, ListHasTheDeviceBackendsAndNoEmulator) {
   const json j = json::parse(r.out);
   std::vector<std::string> names;
   for (const json& b : j.at("backends")) names.push_back(b.at("name"));
-  EXPECT_EQ(names, (std::vector<std::string>{"openhaptics", "firewire", "usb"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"openhaptics", "firewire", "usb", "served",
+                                      "replay"}));
   EXPECT_TRUE(j["backends"][0]["available"].get<bool>()) << r.out;
   EXPECT_EQ(j["backends"][0]["found"], VMH_FAKE_LIBHD);
 }

@@ -75,8 +75,17 @@ TEST(HwCli, ListNamesEveryBackendAndWhyNot) {
   }
   // each backend as it registered: hw/'s (hw/backends.cc), then sim/'s
   EXPECT_EQ(names, (std::vector<std::string>{"openhaptics", "firewire", "usb",
-                                             "emulator", "emulator:firewire"}));
+                                             "served", "replay", "emulator",
+                                             "emulator:firewire"}));
+  EXPECT_TRUE(j["backends"][5]["available"].get<bool>());
+  // served devices are listed from shared memory (whatever this machine
+  // serves now): always available
   EXPECT_TRUE(j["backends"][3]["available"].get<bool>());
+  EXPECT_TRUE(j["backends"][3]["found"].is_array());
+  // a recording has no discovery: the row says what to give instead
+  EXPECT_NE(j["backends"][4]["why_not"].get<std::string>().find(
+                "give a recording folder"),
+            std::string::npos);
 }
 
 TEST(HwCli, ListSaysWhichLibHDItLookedFor) {
