@@ -103,7 +103,8 @@ TickStats TickTimer::stats() const {
   s.overruns = overruns_.load(r);
   s.nominal_period_s = nominal_s_;
   const long periods = std::max(0L, s.ticks - 1);
-  s.period_mean_s = periods > 0 ? sum_period_s_.load(r) / periods : 0.0;
+  s.period_mean_s = periods > 0 ? sum_period_s_.load(r) / static_cast<double>(periods)
+                                  : 0.0;
   s.period_min_s = min_period_s_.load(r);
   s.period_max_s = max_period_s_.load(r);
   s.period_p50_s = percentile(period_hist_, 0.50, bin_s_);
