@@ -14,29 +14,8 @@
 #include <string.h>
 #include <unistd.h>
 
-static int g_failed = 0;
-static int g_checks = 0;
-#define CHECK(cond, ...)                                          \
-  do {                                                            \
-    ++g_checks;                                                   \
-    if (!(cond)) {                                                \
-      ++g_failed;                                                 \
-      fprintf(stderr, "FAILED %s:%d: %s: ", __FILE__, __LINE__, #cond); \
-      fprintf(stderr, __VA_ARGS__);                               \
-      fputc('\n', stderr);                                        \
-    }                                                             \
-  } while (0)
+#include "hd_check.h"
 
-/* pops every pending error; returns the most recent code (0: none) */
-static HDerror pop_errors(void) {
-  HDerror first = HD_SUCCESS;
-  for (int i = 0; i < 64; ++i) {
-    HDErrorInfo e = hdGetError();
-    if (!HD_DEVICE_ERROR(e)) break;
-    if (first == HD_SUCCESS) first = e.errorCode;
-  }
-  return first;
-}
 
 /* -- what the servo callback sees, written on the scheduler thread -- */
 struct Servo {

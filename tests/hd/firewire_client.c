@@ -41,18 +41,7 @@
 
 #include "tests/hw/firewire/fwsim/fwsim.h"
 
-static int g_failed = 0;
-static int g_checks = 0;
-#define CHECK(cond, ...)                                                 \
-  do {                                                                   \
-    ++g_checks;                                                          \
-    if (!(cond)) {                                                       \
-      ++g_failed;                                                        \
-      fprintf(stderr, "FAILED %s:%d: %s: ", __FILE__, __LINE__, #cond);  \
-      fprintf(stderr, __VA_ARGS__);                                      \
-      fputc('\n', stderr);                                               \
-    }                                                                    \
-  } while (0)
+#include "hd_check.h"
 
 /* -- the bus: fwsim.h's control functions, from the loaded stand-in -- */
 static int (*fw_configure)(const char*);
@@ -125,15 +114,6 @@ static double now_s(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static HDerror pop_errors(void) {
-  HDerror last = HD_SUCCESS;
-  for (int i = 0; i < 64; ++i) {
-    HDErrorInfo e = hdGetError();
-    if (!HD_DEVICE_ERROR(e)) break;
-    if (last == HD_SUCCESS) last = e.errorCode;
-  }
-  return last;
-}
 
 /* -- the servo callback: the command of the phase main asks for -- */
 enum { kPhaseNone = 0, kPhaseForce, kPhaseJointTorque };

@@ -18,28 +18,8 @@
 #include <time.h>
 #include <unistd.h>
 
-static int g_failed = 0;
-static int g_checks = 0;
-#define CHECK(cond, ...)                                                 \
-  do {                                                                   \
-    ++g_checks;                                                          \
-    if (!(cond)) {                                                       \
-      ++g_failed;                                                        \
-      fprintf(stderr, "FAILED %s:%d: %s: ", __FILE__, __LINE__, #cond);  \
-      fprintf(stderr, __VA_ARGS__);                                      \
-      fputc('\n', stderr);                                               \
-    }                                                                    \
-  } while (0)
+#include "hd_check.h"
 
-static HDerror pop_errors(void) {
-  HDerror last = HD_SUCCESS;
-  for (int i = 0; i < 64; ++i) {
-    HDErrorInfo e = hdGetError();
-    if (!HD_DEVICE_ERROR(e)) break;
-    if (last == HD_SUCCESS) last = e.errorCode;
-  }
-  return last;
-}
 
 static double wall_s(void) {
   struct timespec ts;
