@@ -221,6 +221,32 @@ Kept keep(const ChartSeries& s, bool xlog, bool ylog) {
 }
 
 
+// a series' stroke: its colour, width and dash pattern
+std::string stroke_attrs(const ChartSeries& s, const SeriesLook& look,
+                         const std::string& color) {
+  const std::string dash = !look.dash.empty() ? look.dash
+                           : s.dashed         ? "6 4"
+                                              : "";
+  const double w = look.line_width > 0.0 ? look.line_width : 1.5;
+  return attr("stroke", color) + attr("stroke-width", format("%g", w)) +
+         (dash.empty() ? "" : attr("stroke-dasharray", dash));
+}
+
+// a marker's radius and paint: filled, or a ring (hollow)
+double marker_radius(const SeriesLook& look) {
+  return look.marker_radius > 0.0 ? look.marker_radius : kMarkerRadius;
+}
+std::string marker_paint(const SeriesLook& look, const std::string& color) {
+  return look.hollow ? attr("fill", "none") + attr("stroke", color) +
+                        attr("stroke-width", "1.5")
+                  : attr("fill", color);
+}
+
+// series i's look: the chart's, or the defaults
+SeriesLook look_of(const Chart& chart, std::size_t i) {
+  return i < chart.looks.size() ? chart.looks[i] : SeriesLook{};
+}
+
 // ---------------------------------------------------------------- a chart
 
 constexpr double kSubtitleRow = 14.0;  // the top margin grows by it
@@ -324,7 +350,10 @@ std::string head_svg(const Chart& chart, const Prepared& p, const Layout& l,
          attr("height", px(l.H)) + attr("fill", "white") + "/>\n";
   // the series are clipped to the plot area, widened by a marker so that a
   // point on an axis limit shows whole
-  const double m = kMarkerRadius + 1.0;
+  double m = kMarkerRadius + 1.0;
+  for (const SeriesLook& look : chart.looks) {
+    m = std::max(m, marker_radius(look) + 1.0);
+  }
   svg += "<defs><clipPath" + attr("id", id + "plot-clip") + "><rect" +
          attr("x", px(l.left - m)) + attr("y", px(l.top - m)) +
          attr("width", px(l.plot_w + 2.0 * m)) +
@@ -427,8 +456,8 @@ std::string frame_svg(const Chart& chart, const Layout& l, const std::string& id
 }
 
 // one series, clipped to the plot area
-std::string series_svg(const ChartSeries& s, const Kept& k,
-                       const std::string& color, const Scale& sx,
+std::string series_svg(const ChartSeries& s, const SeriesLook& look,
+                       const Kept& k, const std::string& color, const Scale& sx,
                        const Scale& sy, const std::string& id, std::size_t i) {
   std::string svg = "<g" + attr("class", "series") +
                     attr("id", id + "series-" + std::to_string(i)) +
@@ -446,14 +475,13 @@ std::string series_svg(const ChartSeries& s, const Kept& k,
       p += px(sx.to_px(x)) + "," + px(sy.to_px(y));
     }
     svg += "<polyline" + attr("points", p) + attr("fill", "none") +
-           attr("stroke", color) + attr("stroke-width", "1.5") +
-           (s.dashed ? attr("stroke-dasharray", "6 4") : "") + "/>\n";
+           stroke_attrs(s, look, color) + "/>\n";
   }
   if (s.markers) {
     for (const auto& [x, y] : k.pts) {
       svg += "<circle" + attr("cx", px(sx.to_px(x))) +
-             attr("cy", px(sy.to_px(y))) + attr("r", px(kMarkerRadius)) +
-             attr("fill", color) + "/>\n";
+             attr("cy", px(sy.to_px(y))) + attr("r", px(marker_radius(look))) +
+             marker_paint(look, color) + "/>\n";
     }
   }
   return svg + "</g>\n";
@@ -471,17 +499,16 @@ std::string legend_svg(const Chart& chart, const Prepared& p, const Layout& l) {
     if (s.line) {
       svg += "<line" + attr("x1", px(lx)) + attr("y1", px(ly)) +
              attr("x2", px(lx + kLegendSample)) + attr("y2", px(ly)) +
-             attr("stroke", p.colors[i]) + attr("stroke-width", "1.5") +
-             (s.dashed ? attr("stroke-dasharray", "6 4") : "") + "/>\n";
+             stroke_attrs(s, look_of(chart, i), p.colors[i]) + "/>\n";
     }
     if (s.markers) {
       // a rounded square that looks like the markers: a <circle> here would
       // count as one of the series' markers to a reader of the file
-      const double r = kMarkerRadius;
+      const double r = marker_radius(look_of(chart, i));
       svg += "<rect" + attr("x", px(lx + 0.5 * kLegendSample - r)) +
              attr("y", px(ly - r)) + attr("width", px(2.0 * r)) +
              attr("height", px(2.0 * r)) + attr("rx", px(r)) +
-             attr("fill", p.colors[i]) + "/>\n";
+             marker_paint(look_of(chart, i), p.colors[i]) + "/>\n";
     }
     svg += "<text" + attr("x", px(lx + kLegendSample + 6.0)) +
            attr("y", px(ly + 4.0)) + ">" + escape(s.label) + "</text>\n";
@@ -502,7 +529,8 @@ std::string chart_body(const Chart& chart, const std::string& id) {
          y_ticks_svg(chart, p, l, sy) + "</g>\n";
   svg += frame_svg(chart, l, id);
   for (std::size_t i = 0; i < chart.series.size(); ++i) {
-    svg += series_svg(chart.series[i], p.kept[i], p.colors[i], sx, sy, id, i);
+    svg += series_svg(chart.series[i], look_of(chart, i), p.kept[i],
+                      p.colors[i], sx, sy, id, i);
   }
   return svg + legend_svg(chart, p, l);
 }

@@ -34,6 +34,19 @@ struct ChartSeries {
   bool dashed = false;      // dashed polyline (e.g. a theoretical bound)
 };
 
+// How a series is drawn beyond its colour, for series that may coincide
+// (e.g. two integrators of the same order): a stroke-dasharray of its own
+// (empty: "6 4" when dashed, else solid), the polyline's width, the markers'
+// radius, and hollow markers (a ring in the series' colour, no fill) so that
+// a series drawn under this one shows through. The legend's sample shows the
+// same. (Apart from ChartSeries so that its brace-initialisations stay whole.)
+struct SeriesLook {
+  std::string dash;
+  double line_width = 1.5;
+  double marker_radius = 3.0;
+  bool hollow = false;
+};
+
 struct ChartAxis {
   std::string label;        // with its unit, e.g. "wall time (s)"
   bool log = false;         // base-10 logarithmic
@@ -58,6 +71,8 @@ struct Chart {
   ChartAxis x;
   ChartAxis y;
   std::vector<ChartSeries> series;
+  // looks[i] for series i; a series past its end: the defaults
+  std::vector<SeriesLook> looks;
   std::vector<ChartBand> bands;
   int width_px = 640;
   int height_px = 420;

@@ -194,6 +194,36 @@ const char* colour_of(Integrator i) {
   return kColours[static_cast<int>(i)];
 }
 
+// Euler and implicit are both first order and, on a smooth script, their
+// points can fall on one another (docs/numerics.md section 1). So no curve
+// hides another: euler (drawn first) has a wide line and large dots,
+// implicit (drawn over it) a thin dotted line and rings through which
+// euler's dots show.
+report::SeriesLook look_of(Integrator i) {
+  report::SeriesLook look;
+  if (i == Integrator::kEuler) {
+    look.line_width = 3.5;
+    look.marker_radius = 5.0;
+  } else if (i == Integrator::kImplicit) {
+    look.dash = "2 2";
+    look.hollow = true;
+    look.marker_radius = 3.5;
+  }
+  return look;
+}
+
+// said under the charts' titles when both first-order integrators are drawn
+std::string coincide_note(const PrecisionResult& r) {
+  bool euler = false, implicit = false;
+  for (const OrderFit& f : r.fits) {
+    euler = euler || f.integrator == Integrator::kEuler;
+    implicit = implicit || f.integrator == Integrator::kImplicit;
+  }
+  return euler && implicit
+             ? "curves may coincide: euler wide and filled, implicit dotted rings"
+             : "";
+}
+
 }  // namespace
 
 const char* integrator_name(Integrator i) {
@@ -509,6 +539,7 @@ report::Chart precision_chart(const PrecisionResult& r) {
   std::snprintf(title, sizeof title, "work-precision, %.3g s, T = %.3g ms",
                 r.duration_s, r.servo_period_s * 1e3);
   c.title = title;
+  c.subtitle = coincide_note(r);
   c.width_px = 820;
   c.height_px = 480;
   c.x = {"wall time of the run (s)", true};
@@ -523,6 +554,8 @@ report::Chart precision_chart(const PrecisionResult& r) {
       s.y.push_back(row.error.rms_mm);
     }
     c.series.push_back(s);
+    c.looks.resize(c.series.size());
+    c.looks.back() = look_of(f.integrator);
   }
   for (const PrecisionRow& row : r.rows) {
     if (!row.is_default || !row.error.finite) continue;
@@ -562,6 +595,7 @@ report::Chart precision_chart(const PrecisionResult& r) {
 report::Chart precision_order_chart(const PrecisionResult& r) {
   report::Chart c;
   c.title = "error against the physics step";
+  c.subtitle = coincide_note(r);
   c.width_px = 820;
   c.height_px = 480;
   c.x = {"physics step h (s)", true};
@@ -576,6 +610,8 @@ report::Chart precision_order_chart(const PrecisionResult& r) {
       s.y.push_back(row.error.rms_mm);
     }
     c.series.push_back(s);
+    c.looks.resize(c.series.size());
+    c.looks.back() = look_of(f.integrator);
     if (f.points >= 2) {
       report::ChartSeries line;
       char label[96];

@@ -268,7 +268,35 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
     passive.x.push_back(b);
     passive.y.push_back(0.0);
   }
-  if (!passive.x.empty()) c.series.push_back(passive);
+  // Drawn when it reaches a visible length: with b small against the map's
+  // B range (the Omni's 0.028 of 8 N s/m, or 2 of 100 for 1 kg) the whole
+  // line (B from 0 to b) is 2% of both axes or less, a few pixels hidden
+  // under the first markers, so a legend entry would name a line no one can
+  // see. Then the subtitle gives its end points instead.
+  double K_max = 0.0;
+  for (const report::ChartSeries& s : c.series) {
+    for (double k : s.y) K_max = std::max(K_max, k);
+  }
+  double x_span = 0.0, y_span = 0.0;
+  if (!passive.x.empty()) {
+    const auto [x_lo, x_hi] =
+        std::minmax_element(passive.x.begin(), passive.x.end());
+    const auto [y_lo, y_hi] =
+        std::minmax_element(passive.y.begin(), passive.y.end());
+    x_span = *x_hi - *x_lo;
+    y_span = *y_hi - *y_lo;
+  }
+  constexpr double kVisible = 0.05;  // of an axis' data range, ~20 px
+  if (x_span >= kVisible * B_max || y_span >= kVisible * K_max) {
+    c.series.push_back(passive);
+  } else if (!passive.x.empty()) {
+    char note[200];
+    std::snprintf(note, sizeof note,
+                  "passivity bound 2(b-B)/T: %.4g N/m at B = 0, 0 at B = b = "
+                  "%.3g N s/m (too short to draw)",
+                  2.0 * b / base.servo_period_s, b);
+    c.subtitle = note;
+  }
   return report::chart_svg(c);
 }
 

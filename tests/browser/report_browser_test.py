@@ -13,6 +13,12 @@ beyond the Python standard library) and fails on:
     some channel. A clip or a style that leaks from one figure into
     another (the duplicated clip-path ids of issue 31 hid points of the
     stability map) changes the inlined figure and not the standalone one.
+  - under print media (Emulation.setEmulatedMedia "print"), any table or
+    figure whose computed break-inside is not "avoid", or any h1-h3 whose
+    break-after is not "avoid": the print styles that keep a table whole
+    and a heading with what follows it. This checks the rules as the
+    browser applies them, not a printed layout (a table longer than a page
+    must still split).
 Prints, per figure, the pixels compared and the share that differ.
 Exit 0 when all is well, 1 on a failure, 77 (ctest's skip) when Chromium
 cannot be started.
@@ -167,6 +173,27 @@ FIGURES = """(() => Array.from(document.querySelectorAll('figure[data-file]'))
 
 # the share of pixels of two same-sized PNGs (base64) that differ by more
 # than `level` in a channel, computed by the browser's own canvas
+# the print rules as applied: counts, and what breaks them; under screen
+# media the same elements must not avoid breaks (else the check proves
+# nothing about the emulation)
+PRINT_BREAKS = """(() => {
+  const out = {tables: 0, headings: 0, avoiding: 0, bad: []};
+  const name = (el, i) => el.tagName.toLowerCase() + (el.id ? '#' + el.id : '[' + i + ']');
+  document.querySelectorAll('table, figure').forEach((el, i) => {
+    out.tables++;
+    const v = getComputedStyle(el).breakInside;
+    if (v === 'avoid') out.avoiding++;
+    else out.bad.push(name(el, i) + ' break-inside: ' + v);
+  });
+  document.querySelectorAll('h1, h2, h3').forEach((el, i) => {
+    out.headings++;
+    const v = getComputedStyle(el).breakAfter;
+    if (v === 'avoid') out.avoiding++;
+    else out.bad.push(name(el, i) + ' break-after: ' + v);
+  });
+  return out;
+})()"""
+
 COMPARE = """(async (a, b, level) => {
   const load = src => new Promise((ok, bad) => {
     const i = new Image(); i.onload = () => ok(i); i.onerror = bad;
@@ -288,6 +315,21 @@ def main():
             if share > MAX_DIFF_SHARE:
                 failures.append(f"{f['id']}: {100 * share:.3f} % of its pixels differ "
                                 f"from {f['file']} drawn alone")
+        screen = chrome.evaluate(main_page, PRINT_BREAKS)
+        chrome.call("Emulation.setEmulatedMedia", {"media": "print"},
+                    session=main_page)
+        printed = chrome.evaluate(main_page, PRINT_BREAKS)
+        chrome.call("Emulation.setEmulatedMedia", {"media": ""},
+                    session=main_page)
+        print(f"print media: {printed['tables']} tables and figures, "
+              f"{printed['headings']} headings, {len(printed['bad'])} "
+              f"not kept together (screen media: {screen['avoiding']} avoiding)")
+        if printed["tables"] == 0 or printed["headings"] == 0:
+            failures.append("print media: no table or no heading on the page")
+        if screen["avoiding"] == printed["avoiding"]:
+            failures.append("print media: the emulation changed no break rule")
+        for b in printed["bad"][:20]:
+            failures.append("print media: " + b)
         failures += problems_in(chrome, main_page)
     finally:
         chrome.close()

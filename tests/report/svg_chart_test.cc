@@ -258,6 +258,52 @@ TEST(SvgChartTest, DropsPointsItCannotDrawAndSaysHowMany) {
   EXPECT_EQ(count(doc, "<circle"), 4u);
 }
 
+// A series' look (SeriesLook): its own dash pattern, line width, marker
+// radius and hollow markers, in the series and in its legend sample; a
+// series without a look keeps the defaults.
+TEST(SvgChartTest, SeriesLooksForCurvesThatCoincide) {
+  Chart c;
+  c.x = {"h (s)", true};
+  c.y = {"error (mm)", true};
+  ChartSeries under = series({1e-3, 1e-2}, {1e-2, 1e-1}, "under");
+  ChartSeries over = series({1e-3, 1e-2}, {1e-2, 1e-1}, "over");
+  ChartSeries plain = series({1e-3, 1e-2}, {1e-3, 1e-2}, "plain");
+  c.series = {under, over, plain};
+  c.looks.resize(2);
+  c.looks[0].line_width = 3.5;
+  c.looks[0].marker_radius = 5.0;
+  c.looks[1].dash = "2 2";
+  c.looks[1].hollow = true;
+  const std::string doc = chart_svg(c);
+  save("looks", doc);
+  EXPECT_EQ(tag_problems(doc), "");
+  const std::string g0 = series_group(doc, 0), g1 = series_group(doc, 1);
+  const std::string g2 = series_group(doc, 2);
+  EXPECT_NE(g0.find("stroke-width=\"3.5\""), std::string::npos);
+  EXPECT_NE(g0.find("r=\"5.00\""), std::string::npos);
+  EXPECT_EQ(g0.find("stroke-dasharray"), std::string::npos);
+  EXPECT_NE(g1.find("stroke-dasharray=\"2 2\""), std::string::npos);
+  // rings: no fill, the series' colour as stroke
+  EXPECT_EQ(count(g1, "<circle"), 2u);
+  EXPECT_EQ(count(g1, "fill=\"none\""), 3u);  // the polyline and 2 rings
+  EXPECT_NE(g2.find("stroke-width=\"1.5\""), std::string::npos);
+  EXPECT_NE(g2.find("r=\"3.00\""), std::string::npos);
+  // the legend shows the same: the wide line, the dotted one, a ring
+  const std::size_t legend = doc.find("<g class=\"legend\">");
+  ASSERT_NE(legend, std::string::npos);
+  const std::string lg = doc.substr(legend, doc.find("</g>", legend) - legend);
+  EXPECT_NE(lg.find("stroke-width=\"3.5\""), std::string::npos);
+  EXPECT_NE(lg.find("stroke-dasharray=\"2 2\""), std::string::npos);
+  EXPECT_EQ(count(lg, "fill=\"none\""), 1u);
+  // the plot's clip path is wider than the plot area by the largest marker
+  // and a pixel, so that a large dot on an axis limit shows whole
+  const std::size_t clip = doc.find("<clipPath");
+  ASSERT_NE(clip, std::string::npos);
+  const std::size_t rect = doc.find("<rect", clip);
+  const auto a = attributes(doc.substr(rect, doc.find('>', rect) - rect));
+  EXPECT_NEAR(std::stod(a.at("x")), plot_area(doc).x - 6.0, 1e-9);
+}
+
 // Each series in its own group, in order: polyline and/or markers as asked,
 // dashed when asked, a palette colour unless one is given; the legend names
 // them.

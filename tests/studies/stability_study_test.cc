@@ -391,6 +391,30 @@ TEST(StabilityStudyTest, BadInputsNameTheOption) {
   }
 }
 
+// With the device's small b the passivity line (B from 0 to b) would be a
+// pixel or two under the first markers: it is left out of the chart and its
+// legend, and the subtitle gives its end points instead. Hand-made points
+// (no simulation): b = 0.028 N s/m, B up to 8 N s/m, K_crit up to 15000 N/m.
+TEST(StabilityStudyTest, MapChartLeavesOutAPassivityLineTooShortToSee) {
+  const StabilityParams base = make(0.08, 0.028, 1e-3, 0.0, 0, 200);
+  std::vector<MapPoint> pts;
+  for (double B : {0.0, 4.0, 8.0}) {
+    MapPoint p;
+    p.virtual_damping_Ns_per_m = B;
+    p.sim.k_crit_N_per_m = 1800.0 * B + 56.0;
+    p.k_crit_exact_N_per_m = p.sim.k_crit_N_per_m;
+    p.k_bound_gil_N_per_m = 2000.0 * B + 56.0;
+    p.k_passivity_N_per_m = 2.0 * (0.028 - B) / 1e-3;
+    pts.push_back(p);
+  }
+  const std::string svg = stability_map_svg(pts, base);
+  EXPECT_EQ(svg.find("passivity 2(b-B)/T (Colgate"), std::string::npos);
+  EXPECT_EQ(svg.find("id=\"series-3\""), std::string::npos);
+  EXPECT_NE(svg.find("passivity bound 2(b-B)/T: 56 N/m at B = 0, 0 at B = b "
+                     "= 0.028 N s/m"),
+            std::string::npos);
+}
+
 // A small map: K_crit for two B and two delays, its CSV (units in the
 // columns) and its SVG (per delay: markers for the simulated points, the
 // exact and Gil lines; the passivity line).
