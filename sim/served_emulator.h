@@ -12,8 +12,9 @@
 // impedance) pull the grip toward the target a viewer moves; release()
 // lets go again.
 //
-// Threads: the emulator's physics thread, the server's servo thread, and
-// any number of viewers calling the const methods and the hand's.
+// Threads: the emulator's physics thread and the server's servo thread run
+// on their own; the const methods may be called from any thread, the
+// hand's (grab, set_target, release, held, target) from one (a viewer's).
 #ifndef VMHAPTICS_SIM_SERVED_EMULATOR_H_
 #define VMHAPTICS_SIM_SERVED_EMULATOR_H_
 

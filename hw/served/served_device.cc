@@ -27,7 +27,7 @@ bool read_bounded(const Seqlock<T>& lock, T* out) noexcept {
 
 class ServedServer::Loop final : public ServoLoop {
  public:
-  Loop(ServedServer* s) : s_(s) {}
+  explicit Loop(ServedServer* s) : s_(s) {}
   bool tick(double now_s) noexcept override {
     ServedRegion* r = s_->shm_->region();
     ServedState out;
@@ -141,7 +141,11 @@ DeviceError ServedDevice::read_state(DeviceState* state) noexcept {
     return DeviceError::kNotConnected;
   }
   ServedState s;
-  if (!read_bounded(region_->state, &s)) return DeviceError::kTimeout;
+  if (!read_bounded(region_->state, &s)) {
+    // a write that never ends: a server that died in the middle of one
+    const DeviceError gone = server_gone();
+    return gone != DeviceError::kOk ? gone : DeviceError::kTimeout;
+  }
   if (s.tick == 0) return DeviceError::kTimeout;  // nothing published yet
   const double now_s = monotonic_now_s();
   if (now_s - s.server_s > stale_s_) {
