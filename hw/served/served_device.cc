@@ -34,7 +34,7 @@ class ServedServer::Loop final : public ServoLoop {
     const DeviceError e = s_->device_->read_state(&out.state);
     if (e != DeviceError::kOk) {
       out.state.present = 0;
-      ++read_errors_;
+      s_->read_errors_.fetch_add(1, std::memory_order_relaxed);
     }
     ServedCommand c;
     if (read_bounded(r->command, &c)) last_command_ = c;
@@ -49,14 +49,6 @@ class ServedServer::Loop final : public ServoLoop {
     out.command_state = static_cast<std::int32_t>(cs);
     out.commands_seen = last_command_.count;
     r->state.write(out);
-    ServerStats st;
-    st.ticks = static_cast<long>(ticks_);
-    st.commands = last_command_.count;
-    st.command_state = cs;
-    st.tau_applied_Nm = tau;
-    st.client_pid = r->client_pid.load(std::memory_order_relaxed);
-    st.read_errors = read_errors_;
-    s_->stats_.write(st);
     return true;
   }
 
@@ -64,7 +56,6 @@ class ServedServer::Loop final : public ServoLoop {
   ServedServer* s_;
   ServedCommand last_command_;
   std::uint64_t ticks_ = 0;
-  int read_errors_ = 0;
 };
 
 ServedServer::ServedServer(const std::string& name, HapticDevice* device,
@@ -112,6 +103,19 @@ void ServedServer::stop() noexcept {
     thread_.reset();
     device_->write_motor_torques(Vec3::Zero());
   }
+}
+
+ServerStats ServedServer::stats() const noexcept {
+  // what the last tick published, and who holds the client's slot now
+  const ServedState s = last_published();
+  ServerStats st;
+  st.ticks = static_cast<long>(s.tick);
+  st.commands = s.commands_seen;
+  st.command_state = static_cast<CommandState>(s.command_state);
+  st.tau_applied_Nm = s.tau_applied_Nm;
+  st.client_pid = shm_->region()->client_pid.load(std::memory_order_relaxed);
+  st.read_errors = read_errors_.load(std::memory_order_relaxed);
+  return st;
 }
 
 bool ServedServer::serving() const noexcept {

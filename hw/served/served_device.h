@@ -46,7 +46,7 @@ struct ServerStats {
   std::uint64_t commands = 0;  // the client's write count last read
   CommandState command_state = CommandState::kNone;
   Vec3 tau_applied_Nm = Vec3::Zero();
-  int client_pid = 0;          // 0: no client holds the device
+  int client_pid = 0;          // 0: no client holds the device now
   int read_errors = 0;         // the device's failed reads so far
 };
 
@@ -69,7 +69,8 @@ class ServedServer {
   void stop() noexcept;
   bool serving() const noexcept;
 
-  ServerStats stats() const noexcept { return stats_.read(); }
+  // the last tick's, from what it published (any thread)
+  ServerStats stats() const noexcept;
   // the last tick as published to the client (any thread)
   ServedState last_published() const noexcept {
     return shm_->region()->state.read();
@@ -85,7 +86,7 @@ class ServedServer {
   ServerOptions options_;
   std::unique_ptr<Loop> loop_;
   std::unique_ptr<ServoThread> thread_;
-  Seqlock<ServerStats> stats_;
+  std::atomic<int> read_errors_{0};  // the device's failed reads
 };
 
 class ServedDevice final : public HapticDevice {
