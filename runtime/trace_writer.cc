@@ -1,5 +1,6 @@
 #include "runtime/trace_writer.h"
 
+#include <charconv>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -10,15 +11,21 @@ namespace {
 
 constexpr const char* kXyz[] = {"x", "y", "z"};
 
+// std::to_chars gives printf's "%.9g" (and "%ld") text, character for
+// character (the C++17 standard defines it so), at a fraction of the cost:
+// the trace's numbers were a tenth of a case run's time
 void put(std::string* s, double v) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g,", v);
-  *s += buf;
+  const std::to_chars_result r =
+      std::to_chars(buf, buf + sizeof buf - 1, v, std::chars_format::general, 9);
+  *r.ptr = ',';
+  s->append(buf, static_cast<std::size_t>(r.ptr - buf + 1));
 }
 void put_int(std::string* s, long v) {
   char buf[24];
-  std::snprintf(buf, sizeof buf, "%ld,", v);
-  *s += buf;
+  const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf - 1, v);
+  *r.ptr = ',';
+  s->append(buf, static_cast<std::size_t>(r.ptr - buf + 1));
 }
 void put_text(std::string* s, const char* t) {
   *s += t;

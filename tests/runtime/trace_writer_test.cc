@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <random>
 #include <sstream>
 
 #include "runtime/trace_writer.h"
@@ -108,6 +110,47 @@ TEST(TraceWriter, EveryRowHasTheHeadersCellsAndTheRecordsValues) {
   ASSERT_EQ(d.size(), cols.size());
   EXPECT_EQ(d[static_cast<std::size_t>(index_of(cols, "hand_y_mm"))], "nan");
   EXPECT_EQ(d[static_cast<std::size_t>(index_of(cols, "phase"))], "");
+}
+
+// The numbers are written by std::to_chars; their text must be printf's
+// "%.9g" (what the trace wrote before, and what readers of it were checked
+// on), over magnitudes from denormals to 1e300, both signs, the values
+// with nine and fewer digits, and the non-finite ones.
+TEST(TraceWriter, NumbersAreWrittenAsPrintfWritesThem) {
+  TraceLayout bare;
+  const auto cols = trace_columns(bare);
+  const auto t_col = static_cast<std::size_t>(index_of(cols, "t_s"));
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> mantissa(1.0, 10.0);
+  std::uniform_int_distribution<int> exponent(-320, 300);
+  std::vector<double> values = {0.0, -0.0, 1.0, -1.0, 0.1, 1e-3, 123456789.0,
+                                1234567891.0, 0.5e-323, 1e300,
+                                std::numeric_limits<double>::infinity(),
+                                -std::numeric_limits<double>::infinity(),
+                                std::nan(""), -std::nan(""),
+                                std::numeric_limits<double>::max(),
+                                std::numeric_limits<double>::denorm_min()};
+  for (int i = 0; i < 200000; ++i) {
+    double v = mantissa(rng) * std::pow(10.0, exponent(rng));
+    if (i % 2) v = -v;
+    if (i % 5 == 0) v = std::round(v * 1e4) / 1e4;  // few digits
+    values.push_back(v);
+  }
+  int mismatches = 0;
+  std::string row;
+  for (double v : values) {
+    TickRecord r;
+    r.t_s = v;
+    row.clear();
+    append_trace_row(r, bare, &row);
+    const std::string got = cells(row.substr(0, row.size() - 1))[t_col];
+    char want[48];
+    std::snprintf(want, sizeof want, "%.9g", v);
+    if (got != want && ++mismatches <= 5) {
+      ADD_FAILURE() << "wrote " << got << ", printf writes " << want;
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
 }
 
 TEST(TraceWriter, WritesHeaderAndRowsAndNamesAFailedWrite) {
