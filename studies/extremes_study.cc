@@ -448,7 +448,9 @@ ExtremeResult run_extreme(const ExtremeScenario& s,
   r.scenario = s;
   std::string name;
   const std::string scene = sim::resolve_scene(s.base, &name);
-  std::vector<std::string> sets = {"duration_s=" + std::to_string(kExtremeDurationS)};
+  std::vector<std::string> sets = {
+      "duration_s=" + std::to_string(kExtremeDurationS),
+      std::string("integrator=") + kExtremeIntegrator};
   sets.insert(sets.end(), s.overrides.begin(), s.overrides.end());
   ClosedLoop loop(scene, sets);
   read_limits(loop, &r);

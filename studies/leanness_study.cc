@@ -73,6 +73,10 @@ struct VariantLoop {
   std::vector<Joints> q_read;   // what the controller read, per tick
 };
 
+// MuJoCo 2.2.2's own stack size for these scenes (it sizes it from njmax
+// = 500 and nconmax = 100 when <size nstack> is not given)
+constexpr int kMujocoDefaultStack = 1281600;
+
 void switch_on(ClosedLoop* loop, unsigned ingredients) {
   // ClosedLoop owns its model non-const (load_model returns an mjModel*)
   // and hands it out read-only; the variants change only option flags,
@@ -178,7 +182,16 @@ std::vector<VariantLoop> make_loops(const std::string& scene,
     v.result.variant = variant;
     v.result.wall_time_s = std::numeric_limits<double>::infinity();
     v.result.cpu_time_s = std::numeric_limits<double>::infinity();
-    v.loop = std::make_unique<ClosedLoop>(scene, sets);
+    // The case scenes size MuJoCo's stack for their few constraint rows
+    // (<size nstack>); with contacts on, every geom may touch every other
+    // and the solver's rows need MuJoCo's own default, 1.28 million
+    // mjtNums. The stack is allocated by mj_makeData from m->nstack, so
+    // it may be raised after compiling (nothing else is sized from it).
+    ModelHook hook;
+    if (variant.ingredients & kContacts) {
+      hook = [](mjModel* m) { m->nstack = std::max(m->nstack, kMujocoDefaultStack); };
+    }
+    v.loop = std::make_unique<ClosedLoop>(scene, sets, hook);
     switch_on(v.loop.get(), variant.ingredients);
     if (variant.ingredients & kRendering) {
       v.viewer = std::make_unique<ViewerState>(v.loop->model());

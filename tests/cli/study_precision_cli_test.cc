@@ -43,10 +43,10 @@ TEST(StudyPrecisionCli, PrintsJsonAndWritesTableAndCharts) {
   EXPECT_EQ(j.at("case"), "case1");
   EXPECT_EQ(j.at("quantize"), 0);
   EXPECT_EQ(j.at("ticks"), 200);
-  // euler: 1 ms, 0.5 ms; rk4: 1 ms (the default), 0.5 ms
+  // euler: 1 ms (the default), 0.5 ms; rk4: 1 ms, 0.5 ms
   EXPECT_EQ(j.at("rows").size(), 4u);
   EXPECT_EQ(j.at("orders").size(), 2u);
-  EXPECT_EQ(j.at("default").at("integrator"), "rk4");
+  EXPECT_EQ(j.at("default").at("integrator"), "euler");
   EXPECT_DOUBLE_EQ(j.at("default").at("h_s").get<double>(), 1e-3);
   EXPECT_TRUE(j.at("default").at("on_front").is_boolean());
   EXPECT_EQ(j.at("reference").at("integrator"), "rk4");

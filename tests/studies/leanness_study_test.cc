@@ -60,7 +60,7 @@ TEST_F(LeannessStudy, EveryVariantRanEveryTick) {
   const CaseLeanness& c = result_->cases[0];
   EXPECT_EQ(c.nv, 6);
   EXPECT_EQ(c.ticks, 200);
-  EXPECT_EQ(c.substeps, 1);  // RK4, h = T = 1 ms (models/cases/)
+  EXPECT_EQ(c.substeps, 1);  // Euler, h = T = 1 ms (models/cases/)
   ASSERT_EQ(c.variants.size(), vmh::studies::leanness_variants().size());
   for (const VariantResult& v : c.variants) {
     EXPECT_GT(v.wall_time_s, 0.0) << v.variant.name;

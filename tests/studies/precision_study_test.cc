@@ -143,15 +143,15 @@ TEST(PrecisionStudy, CaseOneAsComposed) {
   o.reference_check_step_s = 5e-5;
   const PrecisionResult r = run_precision_study(o);
 
-  // the scene's own setting is a row, and the study knows it: RK4 at
+  // the scene's own setting is a row, and the study knows it: Euler at
   // 1 ms, one step per servo tick (models/cases/case1.xml), already a rung
-  EXPECT_EQ(r.default_integrator, Integrator::kRk4);
+  EXPECT_EQ(r.default_integrator, Integrator::kEuler);
   EXPECT_DOUBLE_EQ(r.default_step_s, 1e-3);
   int defaults = 0;
   for (const PrecisionRow& row : r.rows) {
     if (row.is_default) {
       ++defaults;
-      EXPECT_EQ(row.integrator, Integrator::kRk4);
+      EXPECT_EQ(row.integrator, Integrator::kEuler);
       EXPECT_DOUBLE_EQ(row.step_s, 1e-3);
       EXPECT_EQ(row.substeps, 1);
     }

@@ -69,6 +69,22 @@ Joints closed_form_acceleration(const Vec3& tau_Nm) {
 
 TEST(ResponseSim, EarlyResponseFollowsTheMassMatrix) {
   ResponseSimulator sim(kScene);
+  // The most 4 ms of constant acceleration a from rest can move the arm:
+  // a t^2 / 2 with t = 4 ms in continuous time (RK4 is exact for it); the
+  // case scenes step with semi-implicit Euler at h = 1 ms, whose n steps
+  // give v_k = k a h and q_n = a h^2 n (n + 1) / 2, so t_eff = h sqrt(n (n
+  // + 1)) = 4.47 ms (docs/numerics.md: a quarter more than the continuous
+  // plant over so short a window; the fits are consistent with the
+  // emulator, which steps the same scene)
+  double t_max = 0.0041;
+  {
+    const sim::ClosedLoop loop(kScene, {});
+    const double h = loop.model()->opt.timestep;
+    if (loop.model()->opt.integrator == mjINT_EULER) {
+      const double n = std::round(0.004 / h);
+      t_max = h * std::sqrt(n * (n + 1.0)) * 1.0001;
+    }
+  }
   for (const Vec3& tau : {Vec3(0.05, 0, 0), Vec3(0, 0.05, 0), Vec3(0, 0, 0.05)}) {
     const SimulatedResponse r = sim.simulate(step_input(tau, 0.004), ideal());
     ASSERT_TRUE(r.finite);
@@ -80,7 +96,7 @@ TEST(ResponseSim, EarlyResponseFollowsTheMassMatrix) {
     EXPECT_GT(cosine, 0.999) << "motor torque " << tau.transpose();
     const double t_eff = std::sqrt(2.0 * dq.norm() / a.norm());
     EXPECT_GT(t_eff, 0.0025) << "response too small for 4 ms";
-    EXPECT_LT(t_eff, 0.0041) << "response larger than the closed form allows";
+    EXPECT_LT(t_eff, t_max) << "response larger than the closed form allows";
   }
 }
 
