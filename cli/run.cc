@@ -1,6 +1,7 @@
 // vmhaptics run <case1..case6|scene.xml> [--duration s] [--out DIR]
 //                [--set name=value ...] [--json] [--model FILE]
-// vmhaptics run --all [--out DIR] [--jobs N]
+// vmhaptics run --all [--out DIR] [--jobs N] [--sides fitted|full]
+//                [--trace-sides]
 //
 // Prints a table of the error to the path against the run time (or, with
 // --json, one JSON object holding every case's summary), and writes
@@ -41,6 +42,8 @@ struct RunOptions {
   bool json = false;
   bool duration_given = false;
   std::string model;  // a calibrated Omni MJCF; empty: the scene's own
+  std::string sides = "fitted";  // studies/side_runs.h
+  bool trace_sides = false;
 };
 
 void print_table(const std::vector<studies::CaseResult>& results) {
@@ -84,6 +87,17 @@ void run(const RunOptions& o) {
   if (o.jobs < 0) {
     throw UsageError("--jobs: must be >= 0 (0: one per core), got " +
                      std::to_string(o.jobs));
+  }
+  studies::CaseRunOptions run_options;
+  if (o.sides == "full") {
+    run_options.sides = studies::SideMode::kFull;
+  } else if (o.sides != "fitted") {
+    throw UsageError("--sides: 'fitted' or 'full', got '" + o.sides + "'");
+  }
+  run_options.trace_sides = o.trace_sides;
+  if (o.trace_sides && o.out.empty()) {
+    throw UsageError("--trace-sides: needs --out DIR (the traces go to "
+                     "DIR/<case>/trace_side_<n>.csv)");
   }
   std::vector<std::string> sets = o.sets;
   if (o.duration_given) {
@@ -147,7 +161,8 @@ void run(const RunOptions& o) {
       report::Progress bar("run", runs.size());
       studies::run_cases(&runs, sets, o.out, o.jobs, model,
                          o.all ? bar.part(0) : report::ProgressFn{},
-                         [&signals] { return signals.requested(); });
+                         [&signals] { return signals.requested(); },
+                         run_options);
     }
     if (signals.requested()) {
       const int signo = signals.signal_number();
@@ -236,6 +251,16 @@ void register_run(CLI::App* app) {
                   "a calibrated Omni MJCF (e.g. models/omni/calibrated/"
                   "<serial>.xml, any MJCF with models/omni/omni.xml's names) "
                   "whose parameters replace the scene's Omni's");
+  cmd->add_option("--sides", o->sides,
+                  "how the claims' other sides run: fitted (each simulates "
+                  "only the script segments its claims read, settled holds "
+                  "cut short; docs/testbed.md) or full (the whole script, "
+                  "as the main run)")
+      ->type_name("fitted|full")
+      ->default_str("fitted");
+  cmd->add_flag("--trace-sides", o->trace_sides,
+                "also write each side's trace, DIR/<case>/trace_side_<n>.csv "
+                "(summary.json's sides.runs name them)");
   cmd->add_flag("--json", o->json,
                 "print every case's summary as one JSON object instead of "
                 "the table");

@@ -42,20 +42,38 @@ Mat3 turn_to_axis(const Mat3& R_ref, const Vec3& axis_base) {
   return q.toRotationMatrix() * R_ref;
 }
 
-ModelPtr load_hooked(const std::string& path, const ModelHook& hook) {
+ModelPtr copy_model(const mjModel& m, const std::string& path) {
+  ModelPtr copy(mj_copyModel(nullptr, &m));
+  if (!copy) throw SimError(path + ": mj_copyModel failed");
+  return copy;
+}
+
+}  // namespace
+
+ModelPtr load_scene_model(const std::string& path, const ModelHook& hook) {
   ModelPtr m = load_model(path);
   if (hook) hook(m.get());
   return m;
 }
 
-}  // namespace
-
 ClosedLoop::ClosedLoop(const std::string& scene_path,
                        const std::vector<std::string>& overrides,
                        const ModelHook& model_hook)
     : path_(scene_path),
-      model_(load_hooked(scene_path, model_hook)),
+      model_(load_scene_model(scene_path, model_hook)),
       config_(CaseConfig::from_model(model_.get(), scene_path, overrides)) {
+  init();
+}
+
+ClosedLoop::ClosedLoop(const std::string& scene_path, const mjModel& compiled,
+                       const std::vector<std::string>& overrides)
+    : path_(scene_path),
+      model_(copy_model(compiled, scene_path)),
+      config_(CaseConfig::from_model(model_.get(), scene_path, overrides)) {
+  init();
+}
+
+void ClosedLoop::init() {
   apply_model_options();
   setup_timing();
   data_.reset(mj_makeData(model_.get()));
@@ -265,7 +283,18 @@ double ClosedLoop::time_s() const {
 }
 
 bool ClosedLoop::finished() const {
-  return time_s() >= duration_s_ - 0.5 * model_->opt.timestep;
+  return script_time_s() >= duration_s_ - 0.5 * model_->opt.timestep;
+}
+
+void ClosedLoop::skip_script_to(double t_s) {
+  const double now_s = script_time_s();
+  if (!(t_s >= now_s && t_s <= duration_s_)) {
+    throw std::invalid_argument(
+        path_ + ": the script's clock can move forward only, within its " +
+        num(duration_s_) + " s: asked " + num(t_s) + " s at " + num(now_s) +
+        " s");
+  }
+  script_skipped_s_ += t_s - now_s;
 }
 
 std::string PhysicsFault::message() const {
@@ -295,6 +324,7 @@ void ClosedLoop::reset() {
   chain_->reset();
   tick_count_ = 0;
   substep_count_ = 0;
+  script_skipped_s_ = 0.0;
   rng_state_ = jitter_seed_;
   energy_motor_J_ = 0.0;
   energy_hand_J_ = 0.0;
@@ -395,7 +425,9 @@ Vec3 ClosedLoop::nearest_on_path_mm(const Vec3& p_mm) const {
 }
 
 void ClosedLoop::tick(TickRecord* row) {
-  const double t = time_s();
+  // the script's clock (the physics' own, unless a run skipped ahead)
+  const double t = script_time_s();
+  const double t_physics = time_s();
   const double t_script = std::min(t, duration_s_);
   row->segment = script_->segment_at(t_script);
   if (manual_hand_) {
@@ -409,7 +441,7 @@ void ClosedLoop::tick(TickRecord* row) {
   injector_->set_time_s(t);
   // the chain: the reading through the guard (and the safety layer), the
   // controller, the write; the loop's clock is simulated time
-  chain_->tick(t, t, row);
+  chain_->tick(t, t_physics, row);
   // what the (possibly injected) sensor said, even where the guard refused
   row->q_dh = device_to_dh_joints(injector_->last_reading());
   row->fault_injected = injector_->active();

@@ -75,6 +75,11 @@ class PhysicsError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The scene at `path` compiled, `model_hook` applied (if set): what the
+// second ClosedLoop constructor copies. Throws SimError as load_model does.
+ModelPtr load_scene_model(const std::string& path,
+                          const ModelHook& model_hook = {});
+
 class ClosedLoop {
  public:
   // Loads the scene, reads its parameters (with `overrides`), builds the
@@ -86,6 +91,11 @@ class ClosedLoop {
   ClosedLoop(const std::string& scene_path,
              const std::vector<std::string>& overrides,
              const ModelHook& model_hook = {});
+  // The same from a scene already compiled (load_scene_model()), which the
+  // loop copies: the runs of one case on its several sides compile the
+  // scene once. `scene_path` names the scene in messages.
+  ClosedLoop(const std::string& scene_path, const mjModel& compiled,
+             const std::vector<std::string>& overrides);
   ~ClosedLoop();
   ClosedLoop(const ClosedLoop&) = delete;
   ClosedLoop& operator=(const ClosedLoop&) = delete;
@@ -122,11 +132,23 @@ class ClosedLoop {
   // (TickRecord::force_reference_N).
   void set_reference(const ControllerParams& params);
 
+  // the physics' time since reset(): ticks (or, jittered, physics steps)
+  // times their period
   double time_s() const;
+  // The script's clock: time_s() plus what skip_script_to() skipped (equal
+  // to time_s() until then). The hand's target, TickRecord::t_s and
+  // ::segment, the fault schedule and finished() read it.
+  double script_time_s() const { return time_s() + script_skipped_s_; }
+  // Moves the script's clock forward to t_s (no earlier than
+  // script_time_s(), no later than duration_s), the physics' state as it
+  // is: what a run does once the plant has settled in a hold whose target
+  // stands still, to spare simulating the rest of the hold
+  // (studies/side_runs.h). Throws std::invalid_argument out of that range.
+  void skip_script_to(double t_s);
   // the run's length in ticks at the nominal period; with servo jitter the
   // count differs, so loop until finished()
   std::int64_t ticks_per_run() const { return ticks_per_run_; }
-  // whether time_s() has reached duration_s
+  // whether script_time_s() has reached duration_s
   bool finished() const;
   // physics steps per tick at the nominal period
   int substeps() const { return substeps_; }
@@ -183,6 +205,7 @@ class ClosedLoop {
   // device chain SimDevice <- FaultInjector <- ServoChain (guard, safety,
   // controller); the start pose (sets
   // R_start_base_, returns the joint angles)
+  void init();  // both constructors' work once model_ and config_ are set
   void apply_model_options();
   void setup_timing();
   void setup_jitter(double h);
@@ -231,6 +254,7 @@ class ClosedLoop {
   std::int64_t ticks_per_run_ = 0;
   double duration_s_ = 0.0;  // the script's, read once (the tick reads it)
   std::int64_t tick_count_ = 0;
+  double script_skipped_s_ = 0.0;  // skip_script_to()'s total
   // servo jitter: steps per tick drawn from [lo, hi]; the generator's state
   bool jitter_ = false;
   int jitter_lo_ = 1, jitter_hi_ = 1;

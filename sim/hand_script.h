@@ -47,6 +47,9 @@ class HandScript {
   // index of the segment holding t (the last one past the end)
   int segment_at(double t_s) const;
   const std::vector<ScriptSegment>& segments() const { return segments_; }
+  // how long each segment's target takes to blend in from the previous
+  // one's end (s): a hold's target stands still from t0_s + blend_s() on
+  double blend_s() const { return blend_s_; }
 
   // the geometry the script is built on: start point on the path, the
   // outward direction there, the tangent along which misalignment and the

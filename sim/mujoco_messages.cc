@@ -113,6 +113,21 @@ void MujocoWarningTally::add(const std::string& text) {
   entries.push_back({mujoco_warning_kind(text), text, 1});
 }
 
+void MujocoWarningTally::merge(const MujocoWarningTally& other) {
+  for (const Entry& o : other.entries) {
+    const std::string key = masked(o.text);
+    bool found = false;
+    for (Entry& e : entries) {
+      if (masked(e.text) == key) {
+        e.count += o.count;
+        found = true;
+        break;
+      }
+    }
+    if (!found) entries.push_back(o);
+  }
+}
+
 std::int64_t MujocoWarningTally::total() const {
   std::int64_t n = 0;
   for (const Entry& e : entries) n += e.count;

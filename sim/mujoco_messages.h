@@ -67,6 +67,8 @@ struct MujocoWarningTally {
   std::vector<Entry> entries;  // in the order first seen
 
   void add(const std::string& text);
+  // adds every entry of `other` (its counts), as if its texts came here
+  void merge(const MujocoWarningTally& other);
   std::int64_t total() const;
   // how many of a kind
   std::int64_t count(const std::string& kind) const;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <set>
 
 #include "controller/device_frame.h"
@@ -29,9 +30,13 @@ std::vector<const TickRecord*> settled(const std::vector<TickRecord>& rows,
                                      const std::set<std::string>& names) {
   std::vector<const TickRecord*> out;
   const auto& segs = script.segments();
+  std::vector<char> named(segs.size(), 0);
+  for (std::size_t k = 0; k < segs.size(); ++k) {
+    named[k] = names.count(segs[k].name) > 0 ? 1 : 0;
+  }
   for (const TickRecord& r : rows) {
-    const ScriptSegment& s = segs[static_cast<std::size_t>(r.segment)];
-    if (names.count(s.name) && r.t_s >= s.settled_from_s()) out.push_back(&r);
+    const auto k = static_cast<std::size_t>(r.segment);
+    if (named[k] && r.t_s >= segs[k].settled_from_s()) out.push_back(&r);
   }
   return out;
 }
@@ -184,16 +189,21 @@ std::optional<ControllerParams> reference_params(int thesis_case,
 
 namespace {
 
-// the law's prediction at every row's ground-truth pose (index as rows)
+// the law's prediction at a row's ground-truth pose, worked out when a
+// claim first asks for it and kept (index as rows): the claims read the
+// settled halves of a few segments, a small part of a run's rows
 class Predictions {
  public:
   Predictions(const std::vector<TickRecord>& rows, const ControllerParams& p)
-      : rows_(&rows), p_(p) {
-    at_.reserve(rows.size());
-    for (const TickRecord& r : rows) at_.push_back(predict(r, p));
-  }
+      : rows_(&rows), p_(p), slot_(rows.size(), -1) {}
+  // (a deque: a reference returned stays valid as more are worked out)
   const LawPrediction& at(const TickRecord* r) const {
-    return at_[static_cast<std::size_t>(r - rows_->data())];
+    int& slot = slot_[static_cast<std::size_t>(r - rows_->data())];
+    if (slot < 0) {
+      slot = static_cast<int>(at_.size());
+      at_.push_back(predict(*r, p_));
+    }
+    return at_[static_cast<std::size_t>(slot)];
   }
   // at the ground-truth pose of a row, device frame: the row's true wrist
   // centre (omni_fk of q_true_dh) and the stylus axis of the same angles
@@ -208,7 +218,8 @@ class Predictions {
  private:
   const std::vector<TickRecord>* rows_;
   ControllerParams p_;
-  std::vector<LawPrediction> at_;
+  mutable std::vector<int> slot_;  // per row: its index in at_, or -1
+  mutable std::deque<LawPrediction> at_;
 };
 
 std::vector<Claim> measure_claims(int thesis_case,
@@ -234,12 +245,16 @@ std::vector<Claim> evaluate_claims(int thesis_case,
     }
     // the sweep claim uses the whole segment, the others its settled half
     const bool whole = names.count("sweep") > 0;
+    const std::vector<ScriptSegment>& segs = loop.script().segments();
+    std::vector<char> in_window(segs.size(), 0);
+    for (std::size_t k = 0; k < segs.size(); ++k) {
+      in_window[k] = names.count(segs[k].name) > 0 ? 1 : 0;
+    }
     double sum = 0.0;
     int n = 0, limited = 0;
     for (const TickRecord& r : rows) {
-      const ScriptSegment& s =
-          loop.script().segments()[static_cast<std::size_t>(r.segment)];
-      if (names.count(s.name) && (whole || r.t_s >= s.settled_from_s())) {
+      const auto k = static_cast<std::size_t>(r.segment);
+      if (in_window[k] && (whole || r.t_s >= segs[k].settled_from_s())) {
         sum += r.d_path_mm;
         ++n;
         if (r.out.status & (kStatusForceSaturated | kStatusTorqueSaturated)) {

@@ -59,6 +59,16 @@ void check_trace_fits(const std::string& dir, std::int64_t ticks,
 // streams every tick to trace.csv.
 constexpr std::int64_t kMaxKeptTicks = 60000;
 
+// How run_case() runs a case's other sides (studies/side_runs.h).
+enum class SideMode { kFitted, kFull };
+struct CaseRunOptions {
+  // fitted: each side simulates only what its claims read; full: the
+  // whole script, as the main run (`run --sides`)
+  SideMode sides = SideMode::kFitted;
+  // each side also writes DIR/<case>/trace_side_<n>.csv (`run --trace-sides`)
+  bool trace_sides = false;
+};
+
 // Runs `scene` (with `overrides`) for its duration and, if out_dir is not
 // empty, writes out_dir/<name>/{trace.csv, summary.json, views.svg,
 // history.svg}. `model_file` (not empty): a calibrated Omni MJCF whose
@@ -71,7 +81,8 @@ CaseResult run_case(const std::string& name, const std::string& scene,
                     const std::vector<std::string>& overrides,
                     const std::string& out_dir,
                     const std::string& model_file = "",
-                    const StopFn& stop = {});
+                    const StopFn& stop = {},
+                    const CaseRunOptions& options = {});
 
 // One run of run_cases(): the case's name and scene, and what came of it.
 struct CaseJob {
@@ -94,7 +105,8 @@ void run_cases(std::vector<CaseJob>* jobs,
                const std::string& out_dir, int threads,
                const std::string& model_file = "",
                const report::ProgressFn& progress = {},
-               const StopFn& stop = {});
+               const StopFn& stop = {},
+               const CaseRunOptions& options = {});
 
 // summary.json's pieces, for other writers of the same format (hw run)
 nlohmann::json claim_json(const Claim& c);
