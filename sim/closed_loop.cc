@@ -50,8 +50,9 @@ ModelPtr copy_model(const mjModel& m, const std::string& path) {
 
 }  // namespace
 
-ModelPtr load_scene_model(const std::string& path, const ModelHook& hook) {
-  ModelPtr m = load_model(path);
+ModelPtr load_scene_model(const std::string& path, const ModelHook& hook,
+                          bool headless) {
+  ModelPtr m = headless ? load_model_headless(path) : load_model(path);
   if (hook) hook(m.get());
   return m;
 }

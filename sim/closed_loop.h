@@ -76,9 +76,12 @@ class PhysicsError : public std::runtime_error {
 };
 
 // The scene at `path` compiled, `model_hook` applied (if set): what the
-// second ClosedLoop constructor copies. Throws SimError as load_model does.
+// second ClosedLoop constructor copies. `headless`: without what is only
+// drawn (load_model_headless), for runs that render nothing. Throws
+// SimError as load_model does.
 ModelPtr load_scene_model(const std::string& path,
-                          const ModelHook& model_hook = {});
+                          const ModelHook& model_hook = {},
+                          bool headless = false);
 
 class ClosedLoop {
  public:

@@ -1,7 +1,11 @@
 #include "sim/mujoco_util.h"
 
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <regex>
+#include <sstream>
 
 #include "sim/mujoco_messages.h"
 
@@ -24,18 +28,75 @@ std::string one_line(const char* err, const char* fallback) {
   return msg;
 }
 
-ModelPtr load_locked(const std::string& path) {
+ModelPtr load_locked(const std::string& path, const mjVFS* vfs = nullptr) {
   // mj_loadXML's own message for a missing file is terse; say it plainly
   if (!std::ifstream(path).good()) {
     throw SimError(path + ": cannot open the scene file");
   }
   char err[1024] = "";
-  ModelPtr m(mj_loadXML(path.c_str(), nullptr, err, sizeof err));
+  ModelPtr m(mj_loadXML(path.c_str(), vfs, err, sizeof err));
   if (!m) throw SimError(path + ": " + one_line(err, "MuJoCo could not load it"));
   return m;
 }
 
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// An included file less what is only drawn: geoms of a class whose name
+// begins with "visual" or in geom group 2 (the models' drawn-only group:
+// models/README.md), lights, cameras and the skybox texture. Every body of
+// the models carries its own <inertial> and those geoms neither collide nor
+// weigh, so the physics is the same without them.
+std::string without_drawn(std::string xml) {
+  static const std::regex kDrawn(
+      "<geom[^>]*(class=\"visual[^\"]*\"|group=\"2\")[^>]*/>"
+      "|<light[^>]*/>|<camera[^>]*/>|<texture[^>]*type=\"skybox\"[^>]*/>");
+  return std::regex_replace(xml, kDrawn, "");
+}
+
+// the VFS of load_model_headless: each file the scene includes, as
+// without_drawn() leaves it, under its own name (MuJoCo looks an included
+// file up in the VFS by its name before it reads the disk)
+struct HeadlessVfs {
+  mjVFS vfs;
+  explicit HeadlessVfs(const std::string& scene_path) {
+    mj_defaultVFS(&vfs);
+    const std::string scene = slurp(scene_path);
+    const std::string dir =
+        std::filesystem::path(scene_path).parent_path().string();
+    static const std::regex kInclude("<include\\s+file=\"([^\"]+)\"");
+    for (std::sregex_iterator it(scene.begin(), scene.end(), kInclude), end;
+         it != end; ++it) {
+      const std::string file = (*it)[1].str();
+      const std::string text =
+          without_drawn(slurp((std::filesystem::path(dir) / file).string()));
+      const std::string name = std::filesystem::path(file).filename().string();
+      if (mj_makeEmptyFileVFS(&vfs, name.c_str(), static_cast<int>(text.size())) != 0) {
+        continue;  // a name twice, or the VFS full: that file from the disk
+      }
+      std::memcpy(vfs.filedata[vfs.nfile - 1], text.data(), text.size());
+    }
+  }
+  ~HeadlessVfs() { mj_deleteVFS(&vfs); }
+  HeadlessVfs(const HeadlessVfs&) = delete;
+  HeadlessVfs& operator=(const HeadlessVfs&) = delete;
+};
+
 }  // namespace
+
+ModelPtr load_model_headless(const std::string& path) {
+  install_mujoco_handlers();
+  std::lock_guard<std::mutex> lock(xml_mutex());
+  if (!std::ifstream(path).good()) {
+    throw SimError(path + ": cannot open the scene file");
+  }
+  const HeadlessVfs files(path);
+  return load_locked(path, &files.vfs);
+}
 
 ModelPtr load_model(const std::string& path) {
   install_mujoco_handlers();

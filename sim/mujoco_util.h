@@ -36,6 +36,15 @@ using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 // save_edited_model_xml.
 ModelPtr load_model(const std::string& path);
 
+// The same scene for a run that draws nothing: the files it includes are
+// compiled without what is only drawn (geoms of the "visual" classes and
+// of group 2, lights, cameras, the skybox), which the physics does not
+// read (every body has its own <inertial>; those geoms neither collide nor
+// weigh) but MuJoCo would pose at every step: about a tenth of a case
+// run's time. The trajectory is the same to the last bit
+// (tests/sim/closed_loop_test.cc). Errors as load_model.
+ModelPtr load_model_headless(const std::string& path);
+
 // Loads in_path, calls edit on the model, and writes it as MJCF to out_path
 // with mj_saveLastXML, which saves the last XML parsed with the model's
 // current values: so the load and the save hold load_model's lock together.

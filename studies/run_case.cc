@@ -239,7 +239,9 @@ class CaseWork {
            const CaseRunOptions& options)
       : name_(name), scene_(scene), overrides_(overrides), out_dir_(out_dir),
         model_file_(model_file), options_(options),
-        compiled_(load_scene_model(scene, omni_model_hook(model_file))),
+        // compiled without what is only drawn: nothing here renders
+        compiled_(load_scene_model(scene, omni_model_hook(model_file),
+                                   /*headless=*/true)),
         loop_(std::make_unique<ClosedLoop>(scene, *compiled_, overrides)) {
     result_.name = name;
     result_.scene = scene;
