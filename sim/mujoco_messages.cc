@@ -103,29 +103,22 @@ const char* mujoco_warning_kind(const std::string& text) {
 }
 
 void MujocoWarningTally::add(const std::string& text) {
-  const std::string key = masked(text);
-  for (Entry& e : entries) {
-    if (masked(e.text) == key) {
-      ++e.count;
-      return;
-    }
-  }
-  entries.push_back({mujoco_warning_kind(text), text, 1});
+  add(Entry{mujoco_warning_kind(text), text, 1});
 }
 
 void MujocoWarningTally::merge(const MujocoWarningTally& other) {
-  for (const Entry& o : other.entries) {
-    const std::string key = masked(o.text);
-    bool found = false;
-    for (Entry& e : entries) {
-      if (masked(e.text) == key) {
-        e.count += o.count;
-        found = true;
-        break;
-      }
+  for (const Entry& o : other.entries) add(o);
+}
+
+void MujocoWarningTally::add(const Entry& entry) {
+  const std::string key = masked(entry.text);
+  for (Entry& e : entries) {
+    if (masked(e.text) == key) {
+      e.count += entry.count;
+      return;
     }
-    if (!found) entries.push_back(o);
   }
+  entries.push_back(entry);
 }
 
 std::int64_t MujocoWarningTally::total() const {

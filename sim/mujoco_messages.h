@@ -69,6 +69,9 @@ struct MujocoWarningTally {
   void add(const std::string& text);
   // adds every entry of `other` (its counts), as if its texts came here
   void merge(const MujocoWarningTally& other);
+  // an entry's count to the entry of the same text (numbers masked), or
+  // the entry itself when there is none
+  void add(const Entry& entry);
   std::int64_t total() const;
   // how many of a kind
   std::int64_t count(const std::string& kind) const;

@@ -91,9 +91,7 @@ struct HeadlessVfs {
 ModelPtr load_model_headless(const std::string& path) {
   install_mujoco_handlers();
   std::lock_guard<std::mutex> lock(xml_mutex());
-  if (!std::ifstream(path).good()) {
-    throw SimError(path + ": cannot open the scene file");
-  }
+  // a missing scene has no includes; load_locked then says it is missing
   const HeadlessVfs files(path);
   return load_locked(path, &files.vfs);
 }

@@ -135,6 +135,22 @@ RunMetrics run_metrics(const std::vector<TickRecord>& rows,
   return acc.result();
 }
 
+std::set<std::string> window_segments(const Claim& c) {
+  std::set<std::string> names;
+  std::size_t start = 0;
+  while (start <= c.window.size()) {
+    const std::size_t comma = c.window.find(',', start);
+    const std::size_t end = comma == std::string::npos ? c.window.size() : comma;
+    names.insert(c.window.substr(start, end - start));
+    start = end + 1;
+  }
+  return names;
+}
+
+bool measured_off_path(const Claim& c) {
+  return c.window.find("off_") != std::string::npos;
+}
+
 void merge_sides(std::vector<Claim>* first, const SideLabel& where_first,
                  const std::vector<SideRun>& others) {
   const auto side = [](const Claim& c, const std::string& where) {
@@ -149,7 +165,7 @@ void merge_sides(std::vector<Claim>* first, const SideLabel& where_first,
     return s;
   };
   for (Claim& c : *first) {
-    const bool off_path = c.window.find("off_") != std::string::npos;
+    const bool off_path = measured_off_path(c);
     const auto label = [&](const SideLabel& l) {
       return off_path ? l.where_off_path : l.where;
     };
@@ -235,14 +251,7 @@ std::vector<Claim> evaluate_claims(int thesis_case,
   const Predictions pred(rows, loop.controller_params());
   std::vector<Claim> claims = measure_claims(thesis_case, rows, loop, pred);
   for (Claim& c : claims) {
-    std::set<std::string> names;
-    std::size_t start = 0;
-    while (start <= c.window.size()) {
-      const std::size_t comma = c.window.find(',', start);
-      const std::size_t end = comma == std::string::npos ? c.window.size() : comma;
-      names.insert(c.window.substr(start, end - start));
-      start = end + 1;
-    }
+    const std::set<std::string> names = window_segments(c);
     // the sweep claim uses the whole segment, the others its settled half
     const bool whole = names.count("sweep") > 0;
     const std::vector<ScriptSegment>& segs = loop.script().segments();

@@ -9,6 +9,7 @@
 #define VMHAPTICS_STUDIES_CLAIMS_H_
 
 #include <optional>
+#include <set>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -62,6 +63,14 @@ struct Claim {
   bool partial = false;
   std::string holds_where;
 };
+
+// The script segments a claim is measured over (Claim::window, split at
+// its commas).
+std::set<std::string> window_segments(const Claim& c);
+// Whether a claim is measured over the off-path holds (its window names
+// off_out, off_out_misaligned or off_in): the claims a near-path side
+// feeds (SideRun::off_path_only).
+bool measured_off_path(const Claim& c);
 
 // Where a run of a case was tried, as a side's label.
 struct SideLabel {

@@ -260,15 +260,21 @@ class CaseWork {
     remaining_ = static_cast<int>(runs());
   }
 
-  // what MuJoCo said while the case was loaded, for the summary
-  void add_messages(const MujocoWarningTally& t) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    messages_.merge(t);
+  // The case loaded, with what MuJoCo said while loading it (for the
+  // summary; each run keeps its own).
+  static std::unique_ptr<CaseWork> load(
+      const std::string& name, const std::string& scene,
+      const std::vector<std::string>& overrides, const std::string& out_dir,
+      const std::string& model_file, const CaseRunOptions& options) {
+    MujocoWarningScope load_messages;
+    auto work = std::make_unique<CaseWork>(name, scene, overrides, out_dir,
+                                           model_file, options);
+    work->messages_.merge(load_messages.tally());
+    return work;
   }
 
   // the runs: 0 the main run, 1.. the sides
   std::size_t runs() const { return 1 + sides_.size(); }
-  const std::string& name() const { return name_; }
 
   // Runs run i (any thread; each run has its own model and data). Returns
   // true when it was the case's last run to end.
@@ -531,14 +537,8 @@ CaseResult run_case(const std::string& name, const std::string& scene,
                     const std::string& out_dir,
                     const std::string& model_file, const StopFn& should_stop,
                     const CaseRunOptions& options) {
-  std::unique_ptr<CaseWork> work;
-  {
-    // MuJoCo's warnings while loading (each run keeps its own)
-    MujocoWarningScope load_messages;
-    work = std::make_unique<CaseWork>(name, scene, overrides, out_dir,
-                                      model_file, options);
-    work->add_messages(load_messages.tally());
-  }
+  const std::unique_ptr<CaseWork> work =
+      CaseWork::load(name, scene, overrides, out_dir, model_file, options);
   for (std::size_t i = 0; i < work->runs(); ++i) work->run(i, should_stop);
   return work->finish(should_stop);
 }
@@ -568,10 +568,8 @@ void run_cases(std::vector<CaseJob>* jobs,
   report::parallel_for(jobs->size(), n_threads, [&](std::size_t i) {
     CaseJob& job = (*jobs)[i];
     record(&job, [&] {
-      MujocoWarningScope load_messages;
-      work[i] = std::make_unique<CaseWork>(job.name, job.scene, overrides,
-                                           out_dir, model_file, options);
-      work[i]->add_messages(load_messages.tally());
+      work[i] = CaseWork::load(job.name, job.scene, overrides, out_dir,
+                               model_file, options);
     });
   });
   // every run of every case in one pool, the main runs (the longest) first;

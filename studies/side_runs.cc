@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <set>
+#include <string>
 
 namespace vmh::studies {
 // the testbed's types (sim/) by their own names in this file
@@ -18,18 +20,10 @@ SidePlan plan_side(const HandScript& script, const std::vector<Claim>& claims,
   SidePlan plan;
   plan.read.assign(segs.size(), 0);
   for (const Claim& c : claims) {
-    // Claim::window: the segments' names, comma-separated
-    const bool off_path = c.window.find("off_") != std::string::npos;
-    if (off_path_only && !off_path) continue;
-    std::size_t start = 0;
-    while (start <= c.window.size()) {
-      std::size_t end = c.window.find(',', start);
-      if (end == std::string::npos) end = c.window.size();
-      const std::string name = c.window.substr(start, end - start);
-      for (std::size_t k = 0; k < segs.size(); ++k) {
-        if (segs[k].name == name) plan.read[k] = 1;
-      }
-      start = end + 1;
+    if (off_path_only && !measured_off_path(c)) continue;
+    const std::set<std::string> names = window_segments(c);
+    for (std::size_t k = 0; k < segs.size(); ++k) {
+      if (names.count(segs[k].name)) plan.read[k] = 1;
     }
   }
   for (std::size_t k = 0; k < segs.size(); ++k) {
@@ -47,10 +41,10 @@ void use_reference_gains(ClosedLoop* loop) {
 
 namespace {
 
-// whether the claims read a tick of segment `s` at t_s: the whole sweep,
-// the settled half of every other window (studies/claims.cc)
-bool claims_read_tick(const ScriptSegment& s, double t_s) {
-  return s.name == "sweep" || t_s >= s.settled_from_s();
+// where the claims start reading segment `s`: the whole sweep, the settled
+// half of every other window (studies/claims.cc)
+double read_from_s(const ScriptSegment& s) {
+  return s.name == "sweep" ? s.t0_s : s.settled_from_s();
 }
 
 // the largest joint speed of the plant (rad/s)
@@ -81,7 +75,7 @@ void run_side(ClosedLoop* loop, const SidePlan& plan, SideMode mode,
   for (std::size_t k = 0; k < segs.size(); ++k) {
     if (!plan.read[k]) continue;
     const ScriptSegment& s = segs[k];
-    read_s += s.name == "sweep" ? s.t1_s - s.t0_s : s.t1_s - s.settled_from_s();
+    read_s += s.t1_s - read_from_s(s);
   }
   std::vector<TickRecord>& rows = *rows_out;
   rows.clear();
@@ -108,7 +102,7 @@ void run_side(ClosedLoop* loop, const SidePlan& plan, SideMode mode,
     if (trace) trace->add(row);
     const ScriptSegment& s = segs[static_cast<std::size_t>(k)];
     const bool read = plan.read[static_cast<std::size_t>(k)] != 0;
-    if (read && claims_read_tick(s, row.t_s)) rows.push_back(row);
+    if (read && row.t_s >= read_from_s(s)) rows.push_back(row);
     // only a hold whose target stands still can end early
     if (!fitted || !s.hold || s.name == "sweep" ||
         row.t_s < s.t0_s + script.blend_s()) {
