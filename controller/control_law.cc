@@ -76,16 +76,20 @@ Vec6 weighted_residual(const VirtualMechanism& vm, const RmPose& rm,
 
 namespace {
 
-// Gauss-Newton over the M active (unlocked) joints, whose indices into theta
-// are active[0..M), in fixed-size matrices:
-// the tick calls it with M = 1 (circle), 3 (sphere) or 3 and 5 (surface,
+// Gauss-Newton over the m active (unlocked) joints, whose indices into
+// theta are active[0..m), in fixed-size M x M matrices, M >= m:
+// the tick calls it with m = 1 (circle), 3 (sphere) or 3 and 5 (surface,
 // held or sliding), and perf put Eigen's dynamic-size LDLT, its triangular
 // solves and the resizes at a fifth of the sphere's Gauss-Newton tick.
+// The other counts (a VM with joints locked) take the next size up: the
+// padding columns of J are zero, so their joints are ones W cannot see
+// (below), their step is 0 and the active block's solve is the same. Each
+// size is compiled once, and the compile is most of this file's.
 template <int M>
 PlacementResult gauss_newton_active(const VirtualMechanism& vm,
                                     const RmPose& rm,
                                     const PlacementOptions& options,
-                                    const int* active, VmAngles* theta,
+                                    const int* active, int m, VmAngles* theta,
                                     const VmPose* pose_at_start,
                                     const VmJacobian* J_at_start) {
   using JacobianM = Eigen::Matrix<double, 6, M>;
@@ -133,12 +137,13 @@ PlacementResult gauss_newton_active(const VirtualMechanism& vm,
       } else {
         vm.jacobian(*theta, &J);
       }
-      for (int k = 0; k < M; ++k) Ja.col(k) = J.col(active[k]);
+      for (int k = 0; k < m; ++k) Ja.col(k) = J.col(active[k]);
+      for (int k = m; k < M; ++k) Ja.col(k).setZero();
       A.noalias() = Ja.transpose() * W * Ja;
       grad.noalias() = Ja.transpose() * (W * r);
       fresh = false;
     }
-    const double mean_diag = A.diagonal().sum() / M + 1e-300;
+    const double mean_diag = A.diagonal().sum() / m + 1e-300;
     // solve with the columns scaled to unit diagonal: the surface mixes
     // prismatic (1) and revolute (L) columns, and unscaled its J^T W J is
     // conditioned ~1/(1 + L^2)^2, which leaves the steps at rounding noise
@@ -157,7 +162,7 @@ PlacementResult gauss_newton_active(const VirtualMechanism& vm,
     result.iterations = it + 1;
     if (!step.allFinite()) break;
     trial = *theta;
-    for (int k = 0; k < M; ++k) trial[active[k]] += step[k];
+    for (int k = 0; k < m; ++k) trial[active[k]] += step[k];
     vm.normalize(&trial);
     // a step below the angles' ulp leaves them as they were (the usual case
     // from the closed form's answer, where the step is ~1e-17 rad): the
@@ -219,6 +224,7 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
   // surface probe stretched toward an RM it cannot reach) the damping grows
   // and the step turns toward steepest descent.
   // the active (unlocked) joints' indices into theta
+  static_assert(kMaxVmDof == 5, "the sizes below cover 1..kMaxVmDof joints");
   int active[kMaxVmDof];
   int m = 0;
   for (int j = 0; j < vm.dof(); ++j) {
@@ -226,19 +232,15 @@ PlacementResult place_gauss_newton(const VirtualMechanism& vm,
   }
   switch (m) {
     case 1:
-      return gauss_newton_active<1>(vm, rm, options, active, theta,
+      return gauss_newton_active<1>(vm, rm, options, active, m, theta,
                                     pose_at_start, J_at_start);
     case 2:
-      return gauss_newton_active<2>(vm, rm, options, active, theta,
-                                    pose_at_start, J_at_start);
     case 3:
-      return gauss_newton_active<3>(vm, rm, options, active, theta,
+      return gauss_newton_active<3>(vm, rm, options, active, m, theta,
                                     pose_at_start, J_at_start);
     case 4:
-      return gauss_newton_active<4>(vm, rm, options, active, theta,
-                                    pose_at_start, J_at_start);
     case 5:
-      return gauss_newton_active<5>(vm, rm, options, active, theta,
+      return gauss_newton_active<5>(vm, rm, options, active, m, theta,
                                     pose_at_start, J_at_start);
     default: {
       // every joint locked: nothing to move
