@@ -16,6 +16,7 @@
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "tests/support/cli_run.h"
+#include "tests/support/constants.h"
 
 namespace vmh {
 namespace {
@@ -24,9 +25,9 @@ using nlohmann::json;
 using testing::CliRun;
 using testing::run;
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
-Vec3 vec3(const json& j) { return Vec3(j[0], j[1], j[2]); }
+Vec3 ctl_vec3(const json& j) { return Vec3(j[0], j[1], j[2]); }
 
 Vec6 vec6(const json& j) {
   Vec6 v;
@@ -197,10 +198,10 @@ TEST(CtlJson, OrientationDampingIsItsOwnOption) {
 TEST(CtlOptions, ForceLimitFromTheTable) {
   const std::string q = " --q 0.1,0.2,0.3,0.4,0.5,0.6";
   const json free = ctl("--kpos 2" + q);
-  const double f = vec3(free["force_device_N"]).norm();
+  const double f = ctl_vec3(free["force_device_N"]).norm();
   ASSERT_GT(f, 0.2);
   const json capped = ctl("--kpos 2 --force-limit-N 0.1" + q);
-  EXPECT_NEAR(vec3(capped["force_device_N"]).norm(), 0.1, 1e-12);
+  EXPECT_NEAR(ctl_vec3(capped["force_device_N"]).norm(), 0.1, 1e-12);
   EXPECT_NE(std::find(capped["status"].begin(), capped["status"].end(),
                       "force_saturated"),
             capped["status"].end());
@@ -214,21 +215,21 @@ TEST(CtlCircle, CaseOneForceIsKposTimesTheErrorToTheNearestPoint) {
   ASSERT_EQ(j["status"], json::array({"ok"})) << j.dump();
   // the RM is the forward kinematics of q
   const OmniParams p;
-  EXPECT_LE((vec3(j["p_rm_mm"]) - case1_target()).norm(), 1e-9);
-  EXPECT_LE((vec3(j["p_rm_mm"]) - base_to_device_mm(p, omni_fk(p, q).p_base_m))
+  EXPECT_LE((ctl_vec3(j["p_rm_mm"]) - case1_target()).norm(), 1e-9);
+  EXPECT_LE((ctl_vec3(j["p_rm_mm"]) - base_to_device_mm(p, omni_fk(p, q).p_base_m))
                 .norm(),
             1e-12);
   // X(theta_V) is the nearest point of the circle: the pivot plus L along
   // the RM's projection into the plane
-  const Vec3 x_v = vec3(j["x_v_mm"]);
+  const Vec3 x_v = ctl_vec3(j["x_v_mm"]);
   const Vec3 expect_x_v =
       kPivot + 50.0 * Vec3(std::cos(kAngle), std::sin(kAngle), 0.0);
   EXPECT_LE((x_v - expect_x_v).norm(), 1e-8);
   EXPECT_NEAR(j["theta_v"][0].get<double>(), kAngle, 1e-9);
   // with no orientation gain the error is normal to the path, so eq. 3.11
   // passes K_pos e through unchanged
-  const Vec3 F = vec3(j["force_device_N"]);
-  const Vec3 expect_F = 0.2 * (x_v - vec3(j["p_rm_mm"]));
+  const Vec3 F = ctl_vec3(j["force_device_N"]);
+  const Vec3 expect_F = 0.2 * (x_v - ctl_vec3(j["p_rm_mm"]));
   EXPECT_LE((F - expect_F).norm(), 1e-9) << F.transpose();
   EXPECT_NEAR(F.norm(), 0.2 * std::sqrt(8.0), 1e-8);
   EXPECT_LE((vec6(j["f_motion"]).head<3>() - expect_F).norm(), 1e-9);
@@ -239,12 +240,12 @@ TEST(CtlCircle, CaseOneForceIsKposTimesTheErrorToTheNearestPoint) {
 // the force in the base frame
 void expect_tau_is_jacobian_transpose_force(const json& j, const Joints& q) {
   const OmniParams p;
-  const Vec3 F = vec3(j["force_device_N"]);
+  const Vec3 F = ctl_vec3(j["force_device_N"]);
   const Vec3 F_base = device_to_base_vector(F);
-  EXPECT_LE((vec3(j["force_base_N"]) - F_base).norm(), 1e-12);
+  EXPECT_LE((ctl_vec3(j["force_base_N"]) - F_base).norm(), 1e-12);
   const Mat6 J = omni_jacobian(p, q);
   const Vec3 tau = J.topLeftCorner<3, 3>().transpose() * F_base;
-  EXPECT_LE((vec3(j["tau_Nm"]) - tau).norm(), 1e-12) << tau.transpose();
+  EXPECT_LE((ctl_vec3(j["tau_Nm"]) - tau).norm(), 1e-12) << tau.transpose();
   EXPECT_GT(tau.norm(), 1e-3);  // not trivially zero
 }
 
@@ -271,7 +272,7 @@ TEST(CtlConvention, DeviceAnglesGiveTheSameTick) {
     EXPECT_LE((vec6(b["q_device"]) - t).norm(), 1e-15) << vm;
     for (const char* k : {"p_rm_mm", "x_v_mm", "x_r_mm", "force_device_N",
                           "tau_Nm", "tau_motor_Nm"}) {
-      EXPECT_LE((vec3(a[k]) - vec3(b[k])).norm(), 1e-9) << vm << " " << k;
+      EXPECT_LE((ctl_vec3(a[k]) - ctl_vec3(b[k])).norm(), 1e-9) << vm << " " << k;
     }
     EXPECT_LE((vec6(a["f_motion"]) - vec6(b["f_motion"])).norm(), 1e-9) << vm;
     EXPECT_EQ(a["status"], b["status"]) << vm;
@@ -311,10 +312,10 @@ TEST(CtlUnits, LengthUnitChangesTheProjectionButNotCaseOne) {
   const json mm = ctl(kPivotArg + " --kpos 0.2 " + q_arg(q1));
   const json m =
       ctl(kPivotArg + " --kpos 0.2 --length-unit-mm 1000 " + q_arg(q1));
-  EXPECT_LE((vec3(mm["force_device_N"]) - vec3(m["force_device_N"])).norm(),
+  EXPECT_LE((ctl_vec3(mm["force_device_N"]) - ctl_vec3(m["force_device_N"])).norm(),
             1e-9);
-  EXPECT_GT(vec3(mm["force_device_N"]).norm(), 0.1);
-  EXPECT_LE((vec3(mm["x_v_mm"]) - vec3(m["x_v_mm"])).norm(), 1e-9);
+  EXPECT_GT(ctl_vec3(mm["force_device_N"]).norm(), 0.1);
+  EXPECT_LE((ctl_vec3(mm["x_v_mm"]) - ctl_vec3(m["x_v_mm"])).norm(), 1e-9);
   EXPECT_LE((vec6(mm["e"]).head<3>() / 1000 - vec6(m["e"]).head<3>()).norm(),
             1e-12);
   EXPECT_DOUBLE_EQ(m["length_unit_mm"].get<double>(), 1000.0);
@@ -352,8 +353,8 @@ TEST(CtlOptions, GeometricErrorIsTheRotationFromStylusToLink) {
   const json g = ctl("--vm sphere --error geometric " + q);
   const json t = ctl("--vm sphere " + q);
   EXPECT_EQ(g["error_formulation"], "geometric");
-  const Vec3 a = vec3(g["axis_rm"]);
-  const Vec3 link = vec3(g["x_v_mm"]).normalized();  // pivot at the origin
+  const Vec3 a = ctl_vec3(g["axis_rm"]);
+  const Vec3 link = ctl_vec3(g["x_v_mm"]).normalized();  // pivot at the origin
   const Vec3 c = a.cross(link);
   const Vec3 expect = std::atan2(c.norm(), a.dot(link)) * c.normalized();
   EXPECT_LE((vec6(g["e"]).tail<3>() - expect).norm(), 1e-9)
@@ -388,7 +389,7 @@ TEST(CtlOptions, SurfaceFrictionAndLiftOff) {
   const json open = ctl("--vm surface --unilateral " + q);
   EXPECT_TRUE(has(open, "contact_open")) << open["status"];
   EXPECT_FALSE(has(free, "contact_open"));
-  EXPECT_EQ(vec3(open["force_device_N"]), Vec3::Zero());
+  EXPECT_EQ(ctl_vec3(open["force_device_N"]), Vec3::Zero());
   EXPECT_EQ(vec6(open["f_motion"]), Vec6::Zero());
 }
 
@@ -398,7 +399,7 @@ TEST(CtlOptions, RepeatedTicksReuseTheWarmStart) {
   const json five = ctl(kPivotArg + " --kpos 0.2 --ticks 5 " + q_arg(q));
   // converged on the first tick: the later ones start at the answer
   EXPECT_LE(five["placement_iterations"].get<int>(), 1);
-  EXPECT_LE((vec3(one["force_device_N"]) - vec3(five["force_device_N"])).norm(),
+  EXPECT_LE((ctl_vec3(one["force_device_N"]) - ctl_vec3(five["force_device_N"])).norm(),
             1e-9);
   EXPECT_LE(vec6(five["e_dot"]).norm(), 1e-6);
   // a held contact that slid on the first tick has reached the point where
@@ -420,7 +421,7 @@ TEST(CtlOptions, RepeatedTicksReuseTheWarmStart) {
 
 // bad input: one line on stderr naming what was wrong, nothing on stdout,
 // exit code 2
-void expect_usage_error(const std::string& args, const std::string& needle) {
+void expect_ctl_usage_error(const std::string& args, const std::string& needle) {
   const CliRun r = run(args);
   EXPECT_EQ(r.exit_code, 2) << args;
   EXPECT_TRUE(r.out.empty()) << args << " printed " << r.out;
@@ -432,39 +433,39 @@ void expect_usage_error(const std::string& args, const std::string& needle) {
 
 TEST(CtlErrors, BadInputIsAUsageErrorNamingTheOption) {
   const std::string q = " --q 0,0,0,0,0,0";
-  expect_usage_error("ctl --vm cube" + q,
+  expect_ctl_usage_error("ctl --vm cube" + q,
                      "--vm: unknown value 'cube' (expected one of: circle, "
                      "sphere, surface)");
-  expect_usage_error("ctl --q 0,0,0,0,0", "--q: expected 6");
-  expect_usage_error("ctl --q 0,0,x,0,0,0", "item 3 'x' is not a number");
-  expect_usage_error("ctl", "--q");
-  expect_usage_error("ctl --length-mm 0" + q, "--length-mm");
-  expect_usage_error("ctl --length-mm=-5" + q,
+  expect_ctl_usage_error("ctl --q 0,0,0,0,0", "--q: expected 6");
+  expect_ctl_usage_error("ctl --q 0,0,x,0,0,0", "item 3 'x' is not a number");
+  expect_ctl_usage_error("ctl", "--q");
+  expect_ctl_usage_error("ctl --length-mm 0" + q, "--length-mm");
+  expect_ctl_usage_error("ctl --length-mm=-5" + q,
                      "--length-mm: field 'vm_length_mm' must be > 0");
-  expect_usage_error("ctl --error foo" + q,
+  expect_ctl_usage_error("ctl --error foo" + q,
                      "--error: unknown value 'foo' (expected one of: thesis, "
                      "geometric)");
-  expect_usage_error("ctl --placement newton" + q,
+  expect_ctl_usage_error("ctl --placement newton" + q,
                      "--placement: unknown value 'newton'");
-  expect_usage_error("ctl --kpos=-1" + q, "--kpos");
-  expect_usage_error("ctl --kornt=-1" + q, "--kornt");
-  expect_usage_error("ctl --kv abc" + q, "--kv");
-  expect_usage_error("ctl --vm surface --mu=-0.5" + q, "--mu");
-  expect_usage_error("ctl --weights 0,0,0,0,0,0" + q, "--weights");
-  expect_usage_error("ctl --weights 1,1,1" + q,
+  expect_ctl_usage_error("ctl --kpos=-1" + q, "--kpos");
+  expect_ctl_usage_error("ctl --kornt=-1" + q, "--kornt");
+  expect_ctl_usage_error("ctl --kv abc" + q, "--kv");
+  expect_ctl_usage_error("ctl --vm surface --mu=-0.5" + q, "--mu");
+  expect_ctl_usage_error("ctl --weights 0,0,0,0,0,0" + q, "--weights");
+  expect_ctl_usage_error("ctl --weights 1,1,1" + q,
                      "--weights: field 'placement_weights' expects 6");
-  expect_usage_error("ctl --kv-ornt=-1" + q, "--kv-ornt");
-  expect_usage_error("ctl --vm surface --mu=-inf" + q, "--mu");
-  expect_usage_error("ctl --kpos inf" + q, "not finite");
-  expect_usage_error("ctl --projection-weights 1,1,1,1,1,0" + q,
+  expect_ctl_usage_error("ctl --kv-ornt=-1" + q, "--kv-ornt");
+  expect_ctl_usage_error("ctl --vm surface --mu=-inf" + q, "--mu");
+  expect_ctl_usage_error("ctl --kpos inf" + q, "not finite");
+  expect_ctl_usage_error("ctl --projection-weights 1,1,1,1,1,0" + q,
                      "--projection-weights");
-  expect_usage_error("ctl --force-limit-N 0" + q, "--force-limit-N");
-  expect_usage_error("ctl --length-unit-mm 0" + q, "--length-unit-mm");
-  expect_usage_error("ctl --pivot-mm 1,2" + q, "--pivot-mm");
-  expect_usage_error("ctl --ticks 0" + q, "--ticks");
-  expect_usage_error("ctl --ticks 1.5" + q, "--ticks");
-  expect_usage_error("ctl --convention xyz" + q, "--convention");
-  expect_usage_error("ctl --q 0,0,0,0,0,1e999", "not a finite number");
+  expect_ctl_usage_error("ctl --force-limit-N 0" + q, "--force-limit-N");
+  expect_ctl_usage_error("ctl --length-unit-mm 0" + q, "--length-unit-mm");
+  expect_ctl_usage_error("ctl --pivot-mm 1,2" + q, "--pivot-mm");
+  expect_ctl_usage_error("ctl --ticks 0" + q, "--ticks");
+  expect_ctl_usage_error("ctl --ticks 1.5" + q, "--ticks");
+  expect_ctl_usage_error("ctl --convention xyz" + q, "--convention");
+  expect_ctl_usage_error("ctl --q 0,0,0,0,0,1e999", "not a finite number");
 }
 
 TEST(CtlErrors, NonFiniteJointIsAFaultWithZeroForce) {
@@ -476,8 +477,8 @@ TEST(CtlErrors, NonFiniteJointIsAFaultWithZeroForce) {
     const json j = json::parse(r.out);
     EXPECT_EQ(j["status"], json::array({"invalid_input"})) << bad;
     EXPECT_EQ(j["status_code"], kStatusInvalidInput);
-    EXPECT_EQ(vec3(j["force_device_N"]), Vec3::Zero());
-    EXPECT_EQ(vec3(j["tau_Nm"]), Vec3::Zero());
+    EXPECT_EQ(ctl_vec3(j["force_device_N"]), Vec3::Zero());
+    EXPECT_EQ(ctl_vec3(j["tau_Nm"]), Vec3::Zero());
     EXPECT_EQ(vec6(j["f_motion"]), Vec6::Zero());
     EXPECT_TRUE(j["q_dh"][1].is_null());  // JSON has no NaN
     EXPECT_TRUE(j["theta_v"].is_null());
@@ -497,9 +498,9 @@ TEST(CtlErrors, AnOverflowingForceIsANumericalFault) {
   const json j = json::parse(r.out);
   EXPECT_EQ(j["status"], json::array({"numerical_fault"})) << r.out;
   EXPECT_EQ(j["status_code"], kStatusNumericalFault);
-  EXPECT_EQ(vec3(j["force_device_N"]), Vec3::Zero());
-  EXPECT_EQ(vec3(j["tau_Nm"]), Vec3::Zero());
-  EXPECT_EQ(vec3(j["tau_motor_Nm"]), Vec3::Zero());
+  EXPECT_EQ(ctl_vec3(j["force_device_N"]), Vec3::Zero());
+  EXPECT_EQ(ctl_vec3(j["tau_Nm"]), Vec3::Zero());
+  EXPECT_EQ(ctl_vec3(j["tau_motor_Nm"]), Vec3::Zero());
   EXPECT_NE(r.err.find("numerical_fault"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("force_saturated"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "tests/support/cli_run.h"
+#include "tests/support/constants.h"
 
 namespace {
 
@@ -32,7 +33,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using vmh::testing::run;
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 // the environment of one command: the stand-in, its bus, a private
 // calibration store, and a log of the bus's transactions

@@ -23,14 +23,14 @@ using nlohmann::json;
 using vmh::testing::run;
 
 // a private calibration store, so that no test reads another's
-const std::string kEnv =
+const std::string kFirewireEnv =
     "XDG_CONFIG_HOME=" + ::testing::TempDir() + "vmh_hw_fw_cfg ";
 
-fs::path fresh_dir(const std::string& name) {
+fs::path firewire_dir(const std::string& name) {
   return vmh::testing::fresh_dir("vmh_hw_fw_", name);
 }
 
-long lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
+long line_count(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
 
 // A state packet written out by hand, field by field (little-endian):
 //   magic 0x31484d56                      56 4d 48 31
@@ -149,7 +149,7 @@ TEST(HwFirewireCli, BadPacketsAndNumbersAreNamed) {
     const auto r = run(c.args);
     EXPECT_EQ(r.exit_code, 2) << c.args;
     EXPECT_NE(r.err.find(c.names), std::string::npos) << c.args << ": " << r.err;
-    EXPECT_EQ(lines(r.err), 1) << c.args << ": " << r.err;
+    EXPECT_EQ(line_count(r.err), 1) << c.args << ": " << r.err;
     EXPECT_TRUE(r.out.empty()) << c.args;
   }
 }
@@ -174,43 +174,43 @@ TEST(HwFirewireCli, ListHasTheFirewireRows) {
 }
 
 TEST(HwFirewireCli, FirewireWithoutAnAdapterIsOneLineAndExit2) {
-  const fs::path out = fresh_dir("noadapter");
-  const auto r = run("hw record --device firewire --out " + out.string(), kEnv);
+  const fs::path out = firewire_dir("noadapter");
+  const auto r = run("hw record --device firewire --out " + out.string(), kFirewireEnv);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("firewire"), std::string::npos) << r.err;
-  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_EQ(line_count(r.err), 1) << r.err;
   EXPECT_FALSE(fs::exists(out / "trace.csv"));
 }
 
 TEST(HwFirewireCli, UsbIsListProbeAndCaptureOnly) {
-  const auto r = run("hw record --device usb", kEnv);
+  const auto r = run("hw record --device usb", kFirewireEnv);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("payload protocol is not public"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("hw capture"), std::string::npos) << r.err;
-  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_EQ(line_count(r.err), 1) << r.err;
 }
 
 TEST(HwFirewireCli, BadOptionsForTheWireAreNamed) {
   // the emulator's own fault names are not packet faults
-  const auto f = run("hw probe --device emulator:firewire --fault drop@1:5", kEnv);
+  const auto f = run("hw probe --device emulator:firewire --fault drop@1:5", kFirewireEnv);
   EXPECT_EQ(f.exit_code, 2);
   EXPECT_NE(f.err.find("'drop'"), std::string::npos) << f.err;
-  EXPECT_EQ(lines(f.err), 1) << f.err;
+  EXPECT_EQ(line_count(f.err), 1) << f.err;
   // a host decoding mistake seeded into the emulator would never be seen
   const auto s = run("hw probe --device emulator:firewire --emulator-fault joint2_sign",
-                     kEnv);
+                     kFirewireEnv);
   EXPECT_EQ(s.exit_code, 2);
   EXPECT_NE(s.err.find("joint2_sign"), std::string::npos) << s.err;
-  const auto c = run("hw probe --device emulator:firewire:nosuch_case", kEnv);
+  const auto c = run("hw probe --device emulator:firewire:nosuch_case", kFirewireEnv);
   EXPECT_EQ(c.exit_code, 2);
   EXPECT_NE(c.err.find("nosuch_case"), std::string::npos) << c.err;
-  const auto t = run("hw run --device emulator:firewire:case2 case1", kEnv);
+  const auto t = run("hw run --device emulator:firewire:case2 case1", kFirewireEnv);
   EXPECT_EQ(t.exit_code, 2);
   EXPECT_NE(t.err.find("emulator:firewire:case2"), std::string::npos) << t.err;
 }
 
 TEST(HwFirewireCli, ProbeReadsThroughThePackets) {
-  const auto r = run("hw probe --device emulator:firewire --seconds 1", kEnv);
+  const auto r = run("hw probe --device emulator:firewire --seconds 1", kFirewireEnv);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_EQ(j.at("device").at("backend"), "emulator:firewire");
@@ -231,11 +231,11 @@ TEST(HwFirewireCli, ProbeReadsThroughThePackets) {
 // Packet faults in a recording: losses time out, wrong lengths are I/O
 // errors, a bus reset costs a tick; the session goes on to the end.
 TEST(HwFirewireCli, PacketFaultsShowInTheSessionAndItCarriesOn) {
-  const fs::path out = fresh_dir("faults");
+  const fs::path out = firewire_dir("faults");
   const auto r = run("hw record --device emulator:firewire --duration 3 --quiet "
                      "--fault loss@0.8:5,length@1.4:3,reset@2 --out " +
                          out.string(),
-                     kEnv);
+                     kFirewireEnv);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(out / "meta.json");
   const json m = json::parse(in);
@@ -257,12 +257,12 @@ TEST(HwFirewireCli, PacketFaultsShowInTheSessionAndItCarriesOn) {
 }
 
 TEST(HwFirewireCli, UnpluggedForGoodIsDeviceGone) {
-  const fs::path out = fresh_dir("unplug");
+  const fs::path out = firewire_dir("unplug");
   const auto r = run("hw record --device emulator:firewire --fault unplug@1.0:60 "
-                     "--duration 10 --quiet --out " + out.string(), kEnv);
+                     "--duration 10 --quiet --out " + out.string(), kFirewireEnv);
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("not_connected"), std::string::npos) << r.err;
-  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_EQ(line_count(r.err), 1) << r.err;
   EXPECT_TRUE(fs::exists(out / "trace.csv"));
 }
 
@@ -294,10 +294,10 @@ class HwFirewireRunCase : public ::testing::TestWithParam<int> {};
 
 TEST_P(HwFirewireRunCase, ReproducesTheThesisClaims) {
   const std::string name = "case" + std::to_string(GetParam());
-  const fs::path out = fresh_dir("run_" + name);
+  const fs::path out = firewire_dir("run_" + name);
   const auto r = run("hw run --device emulator:firewire " + name +
                          " --quiet --out " + out.string(),
-                     kEnv);
+                     kFirewireEnv);
   const json j = json::parse(r.out);
   ASSERT_TRUE(j.contains("claims")) << r.out << r.err;
   ASSERT_FALSE(j.at("claims").empty());

@@ -19,7 +19,7 @@ using nlohmann::json;
 using vmh::testing::first_line;
 using vmh::testing::run;
 
-const std::string kEnv = std::string("VMH_LIBHD=") + VMH_FAKE_LIBHD + " ";
+const std::string kLibhdEnv = std::string("VMH_LIBHD=") + VMH_FAKE_LIBHD + " ";
 
 int count_lines(const fs::path& p) {
   std::ifstream in(p);
@@ -30,7 +30,7 @@ int count_lines(const fs::path& p) {
 }
 
 TEST(HwOpenHapticsCli, ListFindsTheLibrary) {
-  const auto r = run("hw list", kEnv);
+  const auto r = run("hw list", kLibhdEnv);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   json oh;
   const json list = json::parse(r.out);
@@ -43,7 +43,7 @@ TEST(HwOpenHapticsCli, ListFindsTheLibrary) {
 }
 
 TEST(HwOpenHapticsCli, ProbeIdentifiesAndReads) {
-  const auto r = run("hw probe --device openhaptics --seconds 0.5", kEnv);
+  const auto r = run("hw probe --device openhaptics --seconds 0.5", kLibhdEnv);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_EQ(j.at("device").at("backend"), "openhaptics");
@@ -60,7 +60,7 @@ TEST(HwOpenHapticsCli, ProbeIdentifiesAndReads) {
 TEST(HwOpenHapticsCli, RecordHasTheDevicesOwnKinematics) {
   const fs::path out = vmh::testing::fresh_dir("vmh_hwoh_", "record");
   const auto r = run("hw record --device openhaptics --duration 1 --quiet --out " +
-                         out.string(), kEnv);
+                         out.string(), kLibhdEnv);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string header = first_line(out / "trace.csv");
   for (const char* col : {"q1_rad", "dev_p_x_mm", "dev_R_33", "dev_v_z_mm_s",
@@ -77,7 +77,7 @@ TEST(HwOpenHapticsCli, RunDrivesTheControllerInBothCommandModes) {
     const fs::path out = vmh::testing::fresh_dir("vmh_hwoh_run_", mode);
     const auto r = run(std::string("hw run --device openhaptics --hd-command ") +
                            mode + " case1 --duration 1.5 --quiet --out " +
-                           out.string(), kEnv);
+                           out.string(), kLibhdEnv);
     ASSERT_EQ(r.exit_code, 0) << mode << ": " << r.err;
     const json j = json::parse(r.out);
     // no ground truth on a device: no claims, and it says so
@@ -91,7 +91,7 @@ TEST(HwOpenHapticsCli, RunDrivesTheControllerInBothCommandModes) {
 TEST(HwOpenHapticsCli, DeviceThatStopsAnsweringKeepsTheTrace) {
   const fs::path out = vmh::testing::fresh_dir("vmh_hwoh_", "comm");
   const auto r = run("hw record --device openhaptics:comm_error@800 "
-                     "--duration 10 --quiet --out " + out.string(), kEnv);
+                     "--duration 10 --quiet --out " + out.string(), kLibhdEnv);
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("device_gone"), std::string::npos) << r.err;
   // the 800 frames before the fault are all in the trace
@@ -99,7 +99,7 @@ TEST(HwOpenHapticsCli, DeviceThatStopsAnsweringKeepsTheTrace) {
 }
 
 TEST(HwOpenHapticsCli, UnknownConfigurationIsNamed) {
-  const auto r = run("hw probe --device openhaptics:missing", kEnv);
+  const auto r = run("hw probe --device openhaptics:missing", kLibhdEnv);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("missing"), std::string::npos) << r.err;
 }

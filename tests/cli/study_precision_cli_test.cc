@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 using vmh::testing::first_line;
 using vmh::testing::run;
 
-fs::path fresh_dir(const std::string& name) {
+fs::path precision_dir(const std::string& name) {
   return vmh::testing::fresh_dir("vmh_study_", name);
 }
 
@@ -29,7 +29,7 @@ const char* const kQuick =
     "--integrators euler,rk4";
 
 TEST(StudyPrecisionCli, PrintsJsonAndWritesTableAndCharts) {
-  const fs::path out = fresh_dir("precision");
+  const fs::path out = precision_dir("precision");
   const auto r = run(std::string(kQuick) + " --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
@@ -93,7 +93,7 @@ TEST(StudyPrecisionCli, BadOptionsAreNamedAndWriteNothing) {
       {"--set quantize=1", "--set quantize"},
       {"--set integrator=euler", "--set integrator"},
   };
-  const fs::path out = fresh_dir("precision_bad");
+  const fs::path out = precision_dir("precision_bad");
   for (const Bad& b : bad) {
     const auto r = run(std::string("study precision ") + b.args + " --out " +
                        out.string());
@@ -107,7 +107,7 @@ TEST(StudyPrecisionCli, BadOptionsAreNamedAndWriteNothing) {
 }
 
 TEST(StudyLeannessCli, PrintsJsonAndWritesTable) {
-  const fs::path out = fresh_dir("leanness");
+  const fs::path out = precision_dir("leanness");
   const auto r = run("study leanness --case 2 --duration 0.1 --repeats 1 --out " +
                      out.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -16,7 +16,7 @@ namespace {
 namespace fs = std::filesystem;
 using vmh::testing::run;
 
-fs::path fresh_dir(const std::string& name) {
+fs::path stability_dir(const std::string& name) {
   return vmh::testing::fresh_dir("vmh_stability_", name);
 }
 
@@ -67,7 +67,7 @@ TEST(StudyStabilityCli, PrintsKcritAgainstTheory) {
 }
 
 TEST(StudyStabilityCli, OneTickDelayAndOutputs) {
-  const fs::path out = fresh_dir("delay");
+  const fs::path out = stability_dir("delay");
   const auto r = run(std::string(kBase) +
                      "--delay-ticks 1 --physics-step 1e-5 --out " +
                      out.string());
@@ -90,7 +90,7 @@ TEST(StudyStabilityCli, OneTickDelayAndOutputs) {
 }
 
 TEST(StudyStabilityCli, MapWritesTableAndChart) {
-  const fs::path out = fresh_dir("map");
+  const fs::path out = stability_dir("map");
   const auto r = run(std::string(kBase) +
                      "--map --map-points 2 --map-b-max 4 --delay-ticks 1 "
                      "--physics-step 2e-5 --jobs 2 --out " + out.string());

@@ -15,11 +15,12 @@
 #include "controller/controller.h"
 #include "controller/omni_kinematics.h"
 #include "controller/virtual_mechanism.h"
+#include "tests/support/constants.h"
 
 namespace vmh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 // Appendix D, typed as printed (PI for the listing's PI)
 namespace listing {

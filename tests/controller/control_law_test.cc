@@ -21,11 +21,12 @@
 #include "controller/omni_kinematics.h"  // wrap_angle
 #include "controller/virtual_mechanism.h"
 #include "tests/support/random_vm.h"
+#include "tests/support/constants.h"
 
 namespace vmh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 // the Controller's defaults (ControllerParams::singular_rcond, _damping)
 constexpr double kSingularRcond = 1e-10;
 constexpr double kDamping = 1e-13;

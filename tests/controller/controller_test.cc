@@ -15,11 +15,12 @@
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "tests/support/random_joints.h"
+#include "tests/support/constants.h"
 
 namespace vmh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 constexpr double kL = 50.0;  // mm, listing D.1
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 

@@ -28,11 +28,12 @@
 #include "controller/omni_params.h"
 #include "controller/types.h"
 #include "tests/support/mujoco_kinematics.h"
+#include "tests/support/constants.h"
 
 namespace vmh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 // every identity below holds to rounding; 1e-9 leaves room for ~1e6 ulps
 constexpr double kTol = 1e-9;
 constexpr int kConfigs = 2000;

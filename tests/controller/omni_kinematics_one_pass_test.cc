@@ -20,7 +20,7 @@ using testing::JointSampler;
 constexpr double kAgree = 1e-12;
 
 // rotation vector of R_b R_a^T (the rotation taking a to b), base frame
-Vec3 rotation_between(const Mat3& Ra, const Mat3& Rb) {
+Vec3 one_pass_rotation_between(const Mat3& Ra, const Mat3& Rb) {
   const Eigen::AngleAxisd aa(Rb * Ra.transpose());
   return aa.angle() * aa.axis();
 }
@@ -93,7 +93,7 @@ void check_against_differences(const OmniParams& p, double offset_m,
       const Vec3 ta = a.p_base_m + offset_m * a.R_base.col(2);
       const Vec3 tb = b.p_base_m + offset_m * b.R_base.col(2);
       const Vec3 v = (ta - tb) / (2 * h);
-      const Vec3 w = rotation_between(b.R_base, a.R_base) / (2 * h);
+      const Vec3 w = one_pass_rotation_between(b.R_base, a.R_base) / (2 * h);
       worst = std::max(worst, (J.block<3, 1>(0, i) - v).cwiseAbs().maxCoeff());
       worst = std::max(worst, (J.block<3, 1>(3, i) - w).cwiseAbs().maxCoeff());
     }

@@ -11,6 +11,7 @@
 #include "controller/device_frame.h"
 #include "tests/support/openhaptics_reference.h"
 #include "tests/support/random_joints.h"
+#include "tests/support/constants.h"
 
 namespace vmh {
 namespace {
@@ -19,7 +20,7 @@ using testing::JointSampler;
 using testing::openhaptics_stylus_rotation;
 using testing::openhaptics_wrist_mm;
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 // rotation vector of R_b R_a^T (the rotation taking a to b), base frame
 Vec3 rotation_between(const Mat3& Ra, const Mat3& Rb) {

@@ -21,11 +21,12 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "tests/support/constants.h"
 
 namespace vmh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 // ------------------------------------------------------------------ helpers
 

@@ -12,11 +12,12 @@
 #include "controller/virtual_mechanism.h"
 #include "tests/support/random_vm.h"
 #include "tests/support/vm_cases.h"
+#include "tests/support/constants.h"
 
 namespace vmh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 using testing::all_cases;
 using testing::Case;

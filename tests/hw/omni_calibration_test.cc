@@ -9,11 +9,12 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include "tests/support/constants.h"
 
 namespace vmh::hw {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 // a calibration chosen by hand: offsets of a few tenths of a radian, the
 // nominal encoder signs and §9.2's theta = 5.48 r - 2.74 on a 10-bit ADC

@@ -27,6 +27,7 @@
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/mujoco_kinematics.h"
 #include "tests/support/random_joints.h"
+#include "tests/support/constants.h"
 
 namespace vmh {
 namespace {
@@ -38,7 +39,7 @@ using testing::max_abs_diff;
 using testing::RowJac;
 using RowMat6 = Eigen::Matrix<double, kOmniJoints, kOmniJoints, Eigen::RowMajor>;
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 // kinematic identities hold to rounding: 1e-9 leaves ~1e6 ulps of room
 constexpr double kKinTol = 1e-9;
 // the tendon map is a sum of at most two terms with coefficients +-1

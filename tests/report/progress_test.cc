@@ -99,14 +99,14 @@ TEST(ProgressTest, PartsAddUpAndNeverGoBack) {
 
 TEST(ProgressTest, SilentWhenStderrIsNotATerminal) {
   // CaptureStderr puts a file on descriptor 2, which is no terminal
-  testing::internal::CaptureStderr();
+  ::testing::internal::CaptureStderr();
   const bool terminal = is_terminal(2);
   {
     Progress bar("quiet", 3);
     EXPECT_FALSE(bar.drawing());
     bar.advance(3);
   }
-  const std::string err = testing::internal::GetCapturedStderr();
+  const std::string err = ::testing::internal::GetCapturedStderr();
   EXPECT_FALSE(terminal);
   EXPECT_EQ(err, "");
 }

@@ -24,6 +24,7 @@
 #include "sim/mujoco_util.h"
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/temp_mjcf.h"
+#include "tests/support/constants.h"
 
 namespace vmh::sim {
 namespace {
@@ -31,7 +32,7 @@ namespace {
 using testing::numeric_field;
 using testing::text_field;
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 class CaseConfigTest : public ::testing::Test {
  protected:

@@ -19,14 +19,14 @@
 namespace vmh::sim {
 namespace {
 
-const std::string kScene = std::string(VMH_MODELS_DIR) + "/cases/case1.xml";
+const std::string kSeededScene = std::string(VMH_MODELS_DIR) + "/cases/case1.xml";
 
 // in lockstep
 EmulatorOptions options(const std::string& seeded,
                         HandProgram hand = HandProgram::kTour) {
   EmulatorOptions o;
   o.lockstep = true;
-  o.scene = kScene;
+  o.scene = kSeededScene;
   o.hand = hand;
   o.seeded = parse_seeded_faults(seeded);
   return o;
@@ -244,7 +244,7 @@ TEST(SeededFaults, LongerLinkMovesTheReportedTransform) {
 // the parameter faults reach the emulator's model
 TEST(SeededFaults, ModelFaultsEditTheEmulatorsModel) {
   Emulator emu(options("motor1_sign,motor3_relative,mass_x2,friction_x3,damping_x0.5"));
-  ClosedLoop plain(kScene, {});
+  ClosedLoop plain(kSeededScene, {});
   const mjModel* a = emu.loop().model();
   const mjModel* b = plain.model();
   const int m1 = mj_name2id(a, mjOBJ_ACTUATOR, "m1");

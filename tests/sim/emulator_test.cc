@@ -37,11 +37,12 @@
 #include "sim/sensor_model.h"
 #include "tests/support/alloc_counter.h"
 #include "tests/support/wait.h"
+#include "tests/support/constants.h"
 
 namespace vmh::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 // a fault's duration, s, and the whole servo periods (1 ms in case1) it
 // lasts: taken at the start of a period, over from the first period start

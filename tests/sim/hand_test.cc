@@ -24,7 +24,7 @@ namespace {
 
 using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
-std::string case1() { return std::string(VMH_MODELS_DIR) + "/cases/case1.xml"; }
+std::string case1_scene() { return std::string(VMH_MODELS_DIR) + "/cases/case1.xml"; }
 
 // inertia tensor of body b about its own frame's origin, body axes:
 // principal inertia rotated by body_iquat, moved from the centre of mass by
@@ -42,7 +42,7 @@ Mat3 inertia_about_body_origin(const mjModel* m, int b) {
 class HandTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    model_ = load_model(case1());
+    model_ = load_model(case1_scene());
     data_.reset(mj_makeData(model_.get()));
     grip_ = mj_name2id(model_.get(), mjOBJ_SITE, "grip");
     ASSERT_GE(grip_, 0);
@@ -115,7 +115,7 @@ TEST_F(HandTest, AddsTheHandToTheGripBody) {
   HandParams h;
   h.mass_kg = 0.5;
   h.inertia_kgm2 = Vec3(1e-4, 2e-4, 3e-4);
-  SimHand hand(m, data_.get(), h, case1());
+  SimHand hand(m, data_.get(), h, case1_scene());
 
   EXPECT_NEAR(m->body_mass[b], mass_before_kg + 0.5, 1e-15);
   // mj_setConst ran: the world's subtree carries the extra mass too
@@ -144,7 +144,7 @@ TEST_F(HandTest, AddsTheHandToTheGripBody) {
 // Target 10, -20, 5 mm from the grip, same orientation, everything at rest:
 // F = 135 N/m x dx, no torque.
 TEST_F(HandTest, SpringForceIsStiffnessTimesDisplacement) {
-  SimHand hand(model_.get(), data_.get(), HandParams(), case1());
+  SimHand hand(model_.get(), data_.get(), HandParams(), case1_scene());
   pose(q_);
   HandTargetState target;
   target.p_m = grip_p_m() + Vec3(0.010, -0.020, 0.005);
@@ -165,7 +165,7 @@ TEST_F(HandTest, SpringForceIsStiffnessTimesDisplacement) {
 TEST_F(HandTest, PerAxisStiffnessActsAlongTheDeviceAxes) {
   HandParams p;
   p.k_pos_axes_N_per_m = Vec3(65.0, 88.0, 201.0);  // device x, y, z
-  SimHand hand(model_.get(), data_.get(), p, case1());
+  SimHand hand(model_.get(), data_.get(), p, case1_scene());
   pose(q_);
   struct Push {
     Vec3 d_base_m;
@@ -192,7 +192,7 @@ TEST_F(HandTest, PerAxisStiffnessActsAlongTheDeviceAxes) {
 TEST_F(HandTest, PerAxisDampingActsAlongTheDeviceAxesAndZeroMeansTheScalar) {
   HandParams p;
   p.b_pos_axes_Ns_per_m = Vec3(3.2, 4.6, 9.9);  // device x, y, z
-  SimHand hand(model_.get(), data_.get(), p, case1());
+  SimHand hand(model_.get(), data_.get(), p, case1_scene());
   pose(q_);  // at rest
   HandTargetState target;
   target.p_m = grip_p_m() + Vec3(0.010, 0.0, 0.0);
@@ -209,7 +209,7 @@ TEST_F(HandTest, PerAxisDampingActsAlongTheDeviceAxesAndZeroMeansTheScalar) {
 // Target turned 0.3 rad about world x from the grip, same place: tau =
 // 0.5 N m/rad x 0.3 rad about x; and 0.2 rad about (0, 0.6, 0.8).
 TEST_F(HandTest, SpringTorqueIsStiffnessTimesAngle) {
-  SimHand hand(model_.get(), data_.get(), HandParams(), case1());
+  SimHand hand(model_.get(), data_.get(), HandParams(), case1_scene());
   pose(q_);
   struct Turn {
     Vec3 axis;
@@ -235,7 +235,7 @@ TEST_F(HandTest, SpringTorqueIsStiffnessTimesAngle) {
 // With the grip moving and the target moving: F = B_p (v_target - v_grip),
 // tau = B_r (w_target - w_grip), the grip's twist from J qdot.
 TEST_F(HandTest, DampingActsOnTheRelativeTwist) {
-  SimHand hand(model_.get(), data_.get(), HandParams(), case1());
+  SimHand hand(model_.get(), data_.get(), HandParams(), case1_scene());
   Joints qdot;
   qdot << 0.5, -0.4, 0.3, 1.0, -2.0, 1.5;
   pose(q_, qdot);
@@ -260,7 +260,7 @@ TEST_F(HandTest, DampingActsOnTheRelativeTwist) {
 // The wrench reaches the joints as J_p^T F + J_r^T tau, replacing whatever
 // qfrc_applied held.
 TEST_F(HandTest, WrenchEntersQfrcAppliedThroughTheGripJacobian) {
-  SimHand hand(model_.get(), data_.get(), HandParams(), case1());
+  SimHand hand(model_.get(), data_.get(), HandParams(), case1_scene());
   pose(q_);
   HandTargetState target;
   target.p_m = grip_p_m() + Vec3(-0.004, 0.012, 0.02);
@@ -290,7 +290,7 @@ TEST_F(HandTest, WrenchEntersQfrcAppliedThroughTheGripJacobian) {
 }
 
 TEST_F(HandTest, SetTargetMovesTheMocapBody) {
-  SimHand hand(model_.get(), data_.get(), HandParams(), case1());
+  SimHand hand(model_.get(), data_.get(), HandParams(), case1_scene());
   const int body = mj_name2id(model_.get(), mjOBJ_BODY, "hand_target");
   const int mocap = model_->body_mocapid[body];
   ASSERT_GE(mocap, 0);
@@ -306,7 +306,7 @@ TEST_F(HandTest, SetTargetMovesTheMocapBody) {
 
 TEST_F(HandTest, HandParamsComeFromTheCase) {
   const CaseConfig c = CaseConfig::from_model(
-      model_.get(), case1(),
+      model_.get(), case1_scene(),
       {"hand_mass_kg=0.3", "hand_inertia_kgm2=1e-4,2e-4,3e-4",
        "hand_k_pos_N_per_m=200", "hand_b_pos_Ns_per_m=4",
        "hand_k_rot_Nm_per_rad=0.7", "hand_b_rot_Nms_per_rad=0.01",

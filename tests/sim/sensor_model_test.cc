@@ -18,11 +18,12 @@
 #include <random>
 
 #include "controller/omni_params.h"
+#include "tests/support/constants.h"
 
 namespace vmh::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 constexpr double kEncoderQuantum_rad = 2.0 * kPi / 15000.0;
 
 // how far x is from the nearest whole number

@@ -19,11 +19,12 @@
 #include "sim/mujoco_util.h"
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/temp_mjcf.h"
+#include "tests/support/constants.h"
 
 namespace vmh::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string case1() { return std::string(VMH_MODELS_DIR) + "/cases/case1.xml"; }

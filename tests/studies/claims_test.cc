@@ -16,7 +16,7 @@
 namespace vmh::studies {
 namespace {
 
-std::string scene(int n) { return testing::thesis_case_scene(n); }
+std::string claims_scene(int n) { return testing::thesis_case_scene(n); }
 
 using CaseTest = testing::ThesisCaseTest;
 
@@ -97,7 +97,7 @@ void check_sides(int thesis_case, const Claim& c) {
 // the log and the XML report.
 TEST_P(CaseTest, ThesisClaimsHold) {
   const CaseResult r = run_case("case" + std::to_string(GetParam()),
-                                scene(GetParam()), {}, "");
+                                claims_scene(GetParam()), {}, "");
   ASSERT_FALSE(r.claims.empty());
   EXPECT_TRUE(r.all_claims_pass);
   for (const Claim& c : r.claims) {
@@ -127,7 +127,7 @@ TEST_P(CaseTest, ThesisClaimsHold) {
 // still fails, as for every orientation case.)
 TEST(CaseSix, GeometricErrorHoldsOnBothSides) {
   const CaseResult r =
-      run_case("case6", scene(6), {"error=geometric"}, "");
+      run_case("case6", claims_scene(6), {"error=geometric"}, "");
   ASSERT_FALSE(r.claims.empty());
   for (const Claim& c : r.claims) {
     ASSERT_GE(c.sides.size(), 4u);

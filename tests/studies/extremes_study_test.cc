@@ -23,12 +23,13 @@
 #include "controller/device_frame.h"
 #include "studies/run_case.h"
 #include "tests/support/mujoco_guard.h"
+#include "tests/support/constants.h"
 
 namespace vmh::studies {
 using namespace vmh::sim;  // NOLINT(build/namespaces): the testbed's types
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 std::string scene(const char* name) {
   return std::string(VMH_MODELS_DIR) + "/cases/" + name + ".xml";

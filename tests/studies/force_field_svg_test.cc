@@ -16,11 +16,12 @@
 #include "runtime/trace_writer.h"
 #include "studies/run_case.h"
 #include "tests/support/svg_check.h"
+#include "tests/support/constants.h"
 
 namespace vmh::studies {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 // Samples on a circle of radius 55 mm about (0, 0, 5) in the device's x-y
 // plane, each pulled back toward the 50 mm path with a tangential and a z

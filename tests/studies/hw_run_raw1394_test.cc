@@ -34,7 +34,7 @@ using vmh::testing::thesis_case_scene;
 
 constexpr std::uint64_t kGuid = 0x000b9900000e0e0eull;
 
-runtime::SessionOptions lockstep_session() {
+runtime::SessionOptions raw1394_lockstep_session() {
   runtime::SessionOptions so;
   so.servo.lockstep = true;
   so.progress = false;
@@ -59,7 +59,7 @@ Json run_in_process(const std::string& scene, const std::vector<std::string>& se
   runtime::OpenedDevice dev = reg.open("emulator:firewire:" + scene, rq);
   HwRunCase hw(scene, sets, "", 1.0);
   runtime::SessionResult r;
-  return hw.run(&dev, lockstep_session(), &r);
+  return hw.run(&dev, raw1394_lockstep_session(), &r);
 }
 
 class HwRunRaw1394 : public vmh::testing::ThesisCaseTest {};
@@ -98,7 +98,7 @@ TEST_P(HwRunRaw1394, ACasePassesItsClaimsThroughTheBusCode) {
 
   HwRunCase hw(scene, sets, "", 1.0);
   runtime::SessionResult session;
-  const Json summary = hw.run(&dev, lockstep_session(), &session);
+  const Json summary = hw.run(&dev, raw1394_lockstep_session(), &session);
   ASSERT_EQ(session.clock, "lockstep");
   ASSERT_EQ(session.stop_reason, "duration");
   ASSERT_TRUE(summary.value("claims_judged", false)) << summary.dump();

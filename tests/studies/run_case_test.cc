@@ -82,7 +82,7 @@ TEST(RunCase, NonFinitePhysicsStopsTheRun) {
 // every k-th for its claims and figures, while its metrics still count every
 // tick: memory stays flat however long the run. 61 s at 1 kHz: k = 2.
 TEST(RunCase, ALongRunStreamsEveryTickAndKeepsEveryKth) {
-  const std::string out = testing::TempDir() + "vmh_long_run";
+  const std::string out = ::testing::TempDir() + "vmh_long_run";
   std::filesystem::remove_all(out);
   const CaseResult r =
       run_case("case1", case1(), {"duration_s=61", "script=hold"}, out);
@@ -258,7 +258,7 @@ TEST(RunCases, TheOutputsDoNotDependOnTheThreads) {
 // With --trace-sides each side writes its own trace beside trace.csv, and
 // the summary names it.
 TEST(RunCase, TraceSidesWritesOneTracePerSide) {
-  const std::string out = testing::TempDir() + "vmh_trace_sides";
+  const std::string out = ::testing::TempDir() + "vmh_trace_sides";
   std::filesystem::remove_all(out);
   CaseRunOptions o;
   o.trace_sides = true;

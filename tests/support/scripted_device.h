@@ -5,10 +5,10 @@
 
 #include "controller/types.h"
 #include "device/haptic_device.h"
+#include "tests/support/constants.h"
 
 namespace vmh::testing {
 
-inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kCount = 2.0 * kPi / 15000.0;  // one encoder count, rad
 
 // A device whose readings the test sets, and which records what it was told.

@@ -13,6 +13,7 @@
 
 #include "tests/hw/firewire/fake_transport.h"
 #include "tests/support/alloc_counter.h"
+#include "tests/support/constants.h"
 
 namespace vmh::hw::fw {
 namespace {
@@ -20,7 +21,7 @@ namespace {
 using testing::FakeTransport;
 using testing::make_packet;
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 
 OmniCalibration test_calibration() {
   OmniCalibration c;

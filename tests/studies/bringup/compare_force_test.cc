@@ -18,6 +18,7 @@
 #include "controller/omni_kinematics.h"
 #include "sim/closed_loop.h"
 #include "sim/emulator_hand.h"
+#include "tests/support/constants.h"
 
 namespace vmh::bringup {
 namespace {
@@ -30,10 +31,10 @@ ForceOptions synthetic_options() {
   return o;
 }
 
-const std::string kScene = std::string(VMH_MODELS_DIR) + "/cases/case1.xml";
+const std::string kForceScene = std::string(VMH_MODELS_DIR) + "/cases/case1.xml";
 // device angles (rad), a pose in the middle of the workspace
-const Joints kQ0 = (Joints() << 0.1, 0.3, 0.2, 0.1, 0.3, -0.2).finished();
-constexpr double kPi = 3.14159265358979323846;
+const Joints kForceQ0 = (Joints() << 0.1, 0.3, 0.2, 0.1, 0.3, -0.2).finished();
+using vmh::testing::kPi;
 
 // What is true of the device that recorded the test
 struct Truth {
@@ -57,10 +58,10 @@ double quantize(double v, double counts_per_rev) {
 // one reading before the pulse fails.
 Recording motor_test(int motor, double torque_Nm, double pulse_ms,
                      const Truth& truth) {
-  sim::ClosedLoop loop(kScene, {}, sim::omni_model_hook("", truth.edit));
+  sim::ClosedLoop loop(kForceScene, {}, sim::omni_model_hook("", truth.edit));
   const mjModel* m = loop.model();
   mjData* d = loop.data();
-  const Joints q_dh0 = device_to_dh_joints(kQ0);
+  const Joints q_dh0 = device_to_dh_joints(kForceQ0);
   for (int i = 0; i < 6; ++i) {
     const int j = mj_name2id(m, mjOBJ_JOINT, sim::kOmniJoints[i]);
     d->qpos[m->jnt_qposadr[j]] = q_dh0[i];
@@ -78,7 +79,7 @@ Recording motor_test(int motor, double torque_Nm, double pulse_ms,
       {"motor", motor},
       {"torque_asked_mNm", 1e3 * torque_Nm},
       {"pulse_ms", pulse_ms},
-      {"emulator", {{"scene", kScene}, {"hand", "none"}, {"model", nullptr}}}};
+      {"emulator", {{"scene", kForceScene}, {"hand", "none"}, {"model", nullptr}}}};
   const double h = m->opt.timestep;
   const double pulse_start_s = 0.08;
   std::vector<double> hist_t;
@@ -298,7 +299,7 @@ TEST(CompareForce, WritesTheFigure) {
 // motor torques, and a device Jacobian (linear rows mm/rad over device
 // joints t1..t3) by central differences of the FK, not the controller's J_r
 Recording run_with_jacobian(double column1_sign) {
-  sim::ClosedLoop loop(kScene, {});
+  sim::ClosedLoop loop(kForceScene, {});
   const OmniParams omni;
   Recording r;
   r.dir = "synthetic-run";

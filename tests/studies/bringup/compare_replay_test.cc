@@ -16,7 +16,7 @@
 namespace vmh::bringup {
 namespace {
 
-const std::string kScene = std::string(VMH_MODELS_DIR) + "/cases/case1.xml";
+const std::string kReplayScene = std::string(VMH_MODELS_DIR) + "/cases/case1.xml";
 
 double printed(double v) {
   char buf[32];
@@ -32,11 +32,11 @@ Recording run_recording(const std::vector<std::string>& overrides,
                         double duration_s) {
   std::vector<std::string> sets = overrides;
   sets.push_back("duration_s=" + std::to_string(duration_s));
-  sim::ClosedLoop loop(kScene, sets);
+  sim::ClosedLoop loop(kReplayScene, sets);
   Recording r;
   r.dir = "synthetic-run";
   r.verb = "hw run";
-  r.meta = {{"verb", r.verb}, {"case", "case1"}, {"scene", kScene}};
+  r.meta = {{"verb", r.verb}, {"case", "case1"}, {"scene", kReplayScene}};
   const char* xyz[] = {"x", "y", "z"};
   TickRecord row;
   while (!loop.finished()) {

@@ -201,7 +201,7 @@ TEST(Identify, CalibratedModelCarriesTheFit) {
   fit.friction_scale = 3.3;
   fit.damping_scale = 0.6;
   fit.motor_gain = Vec3(1.0, -1.0, 1.0);
-  const std::string out = testing::TempDir() + "/identify_test_calibrated.xml";
+  const std::string out = ::testing::TempDir() + "/identify_test_calibrated.xml";
   write_calibrated_model(fit, kOmniXml, out, "serial TEST-0001, fitted -- a test");
   std::ifstream in(out);
   std::string first, second;

@@ -7,11 +7,12 @@
 
 #include "controller/omni_params.h"
 #include "sim/sensor_model.h"
+#include "tests/support/constants.h"
 
 namespace vmh::testing {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::testing::kPi;
 constexpr double kNominalLinkMm = 133.35;
 
 using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
