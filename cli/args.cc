@@ -8,14 +8,14 @@
 
 namespace vmh::cli {
 
-namespace {
-
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t");
   if (b == std::string::npos) return "";
   const auto e = s.find_last_not_of(" \t");
   return s.substr(b, e - b + 1);
 }
+
+namespace {
 
 // one item of a list; `where` says which item for the message
 double to_number(const std::string& option, const std::string& raw,

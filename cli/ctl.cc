@@ -51,13 +51,6 @@ struct CtlOptions {
   std::string convention = "dh";
 };
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t");
-  return s.substr(b, e - b + 1);
-}
-
 std::vector<std::string> split(const std::string& text) {
   std::vector<std::string> items;
   std::string::size_type start = 0;
