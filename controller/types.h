@@ -24,6 +24,14 @@ using Joints = Vec6;
 // millimetres per metre: the device frame and OpenHaptics work in mm
 inline constexpr double kMmPerM = 1000.0;
 
+// pi, for the sources that need it as a constant (C++17 has no
+// std::numbers); a source takes it with `using constants::kPi;`, which,
+// unlike a definition of its own, may appear in several sources compiled
+// as one translation unit (a unity build)
+namespace constants {
+inline constexpr double kPi = 3.14159265358979323846;
+}  // namespace constants
+
 }  // namespace vmh
 
 #endif  // VMHAPTICS_CONTROLLER_TYPES_H_

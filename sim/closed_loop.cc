@@ -13,7 +13,7 @@ namespace {
 
 using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
-constexpr double kPi = 3.14159265358979323846;
+using constants::kPi;
 
 // splitmix64 (Steele, Lea & Flood, OOPSLA 2014): a fixed, portable sequence,
 // so that a jitter_seed means the same run with any standard library

@@ -11,7 +11,7 @@ namespace {
 
 using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
-constexpr double kPi = 3.14159265358979323846;
+using constants::kPi;
 constexpr double kTwoPi = 2.0 * kPi;
 // the time the hand takes to carry the stylus to the inkwell, s
 constexpr double kDockMove_s = 1.5;

@@ -21,7 +21,7 @@ using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace fs = std::filesystem;
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using constants::kPi;
 
 std::string vec_text(const Vec3& v) {
   char buf[96];

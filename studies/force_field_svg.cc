@@ -33,7 +33,7 @@ struct View {
 
 const char* axis_name(int i) { return i == 0 ? "x" : i == 1 ? "y" : "z"; }
 
-std::string num(double v) {
+std::string field_num(double v) {
   std::string s = format("%.3g", v);
   return s == "-0" ? "0" : s;
 }
@@ -83,7 +83,7 @@ std::string panel(const std::vector<ForceSample>& s,
     const double c = axis == 0 ? c0 : c1;
     for (double t = std::ceil((c - span / 2) / step) * step; t <= c + span / 2;
          t += step) {
-      const std::string label = num(std::abs(t) < 1e-9 * step ? 0.0 : t);
+      const std::string label = field_num(std::abs(t) < 1e-9 * step ? 0.0 : t);
       if (axis == 0) {
         g += "<line" + attr("x1", px(X(t))) + attr("y1", px(top + kPanel_px)) +
              attr("x2", px(X(t))) + attr("y2", px(top + kPanel_px + 4)) +
@@ -208,14 +208,14 @@ std::string force_field_svg(const std::vector<ForceSample>& samples,
 
   svg += "<text x=\"" + px(kMargin_px) + "\" y=\"18\" font-size=\"13\">" +
          escape("Commanded force along the path (" + path.vm_kind + ", L = " +
-                num(path.length_mm) + " mm): " + std::to_string(picked.size()) +
+                field_num(path.length_mm) + " mm): " + std::to_string(picked.size()) +
                 " samples evenly along the trajectory's length") + "</text>\n";
   svg += "<text x=\"" + px(kMargin_px) + "\" y=\"34\">" +
-         escape("device frame, mm; arrow 1 N = " + num(mm_per_N) +
+         escape("device frame, mm; arrow 1 N = " + field_num(mm_per_N) +
                 " mm; blue: the VM's path" +
                 (plane ? std::string(" (its plane)")
                        : std::string(" (the sphere's outline)")) +
-                "; grey: RM wrist centre; largest |F| " + num(max_F) + " N") +
+                "; grey: RM wrist centre; largest |F| " + field_num(max_F) + " N") +
          "</text>\n";
   for (std::size_t k = 0; k < views.size(); ++k) {
     svg += panel(samples, picked, path, views[k],

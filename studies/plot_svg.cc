@@ -28,7 +28,7 @@ using Pt = std::pair<double, double>;
 // ---------------------------------------------------------------- text
 
 // a number a reader reads: tick labels, titles
-std::string num(double v) {
+std::string plot_num(double v) {
   std::string s = format("%.4g", v);
   if (s == "-0") s = "0";
   return s;
@@ -162,7 +162,7 @@ void draw_axes(Svg& svg, const Frame& f, const std::string& xlabel,
     svg.line(X, f.top, X, bottom, attr("stroke", "#e4e4e4"));
     svg.line(X, bottom, X, bottom + 4.0, attr("stroke", "#444"));
     if (x_numbers) {
-      svg.text(X, bottom + 15.0, num(x), attr("text-anchor", "middle"));
+      svg.text(X, bottom + 15.0, plot_num(x), attr("text-anchor", "middle"));
     }
   }
   for (double y : ticks(f.ylo, f.yhi, f.ystep)) {
@@ -170,7 +170,7 @@ void draw_axes(Svg& svg, const Frame& f, const std::string& xlabel,
     svg.line(f.left, Y, f.left + f.width, Y,
              attr("stroke", y == 0.0 ? "#b0b0b0" : "#e4e4e4"));
     svg.line(f.left - 4.0, Y, f.left, Y, attr("stroke", "#444"));
-    svg.text(f.left - 6.0, Y + 4.0, num(y), attr("text-anchor", "end"));
+    svg.text(f.left - 6.0, Y + 4.0, plot_num(y), attr("text-anchor", "end"));
   }
   svg.rect(f.left, f.top, f.width, f.height,
            attr("fill", "none") + attr("stroke", "#444"));
@@ -259,7 +259,7 @@ void find_snapshot(const std::vector<TickRecord>& rows, const ClosedLoop& loop,
   }
   const double tol = 1.5 * loop.controller_params().servo_period_s;
   if (best == nullptr || std::abs(best->t_s - mid) > tol) {
-    s->note = "t = " + num(mid) + " s (" + s->segment + ") is not in the run";
+    s->note = "t = " + plot_num(mid) + " s (" + s->segment + ") is not in the run";
     return;
   }
   s->row = best;
@@ -442,7 +442,7 @@ void view_legend(Svg& svg, double x, double y, const VmParams& vm) {
                    (dash[0] != '\0' ? attr("stroke-dasharray", dash) : ""));
     };
   };
-  item("VM path: " + kind + ", L = " + num(vm.length_mm) + " mm",
+  item("VM path: " + kind + ", L = " + plot_num(vm.length_mm) + " mm",
        stroke("#555", "1.2", vm.kind == VmKind::kSurface ? "6 3" : ""));
   item("RM wrist centre p over the run", stroke("#a8a8a8", "0.8", ""));
   item("p at the snapshot", [&svg](double x0, double y0) {
@@ -450,15 +450,15 @@ void view_legend(Svg& svg, double x, double y, const VmParams& vm) {
   });
   item("pivot -> X(theta_V), the placed VM", stroke("#d00000", "2", ""));
   item("pivot -> X(theta_R), VM along the stylus", stroke("#00a000", "2", ""));
-  item("stylus axis a at p, " + num(kPlotStylusMm) + " mm",
+  item("stylus axis a at p, " + plot_num(kPlotStylusMm) + " mm",
        stroke("#000", "3", ""));
-  item("force F from p, " + num(kPlotForceMmPerN) + " mm per N",
+  item("force F from p, " + plot_num(kPlotForceMmPerN) + " mm per N",
        [&svg](double x0, double y0) {
          arrow(svg, x0, y0, x0 + 26.0, y0, "#c000c0", "");
        });
   item("components of F in the view", stroke("#c000c0", "1", "3 2"));
-  item("pivot at (" + num(vm.pivot_mm.x()) + ", " + num(vm.pivot_mm.y()) +
-           ", " + num(vm.pivot_mm.z()) + ") mm",
+  item("pivot at (" + plot_num(vm.pivot_mm.x()) + ", " + plot_num(vm.pivot_mm.y()) +
+           ", " + plot_num(vm.pivot_mm.z()) + ") mm",
        [&svg](double x0, double y0) {
          svg.line(x0 + 9.0, y0, x0 + 17.0, y0, attr("stroke", "#000"));
          svg.line(x0 + 13.0, y0 - 4.0, x0 + 13.0, y0 + 4.0,

@@ -16,10 +16,10 @@ namespace vmh::studies {
 namespace {
 
 using report::svg::escape;
-using Json = nlohmann::json;
+using PageJson = nlohmann::json;
 
 // a number as a reader reads it: 4 significant digits, integers whole
-std::string num(const Json& v) {
+std::string num(const PageJson& v) {
   if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
   if (v.is_number_integer()) return std::to_string(v.get<long long>());
   if (v.is_number()) {
@@ -31,15 +31,15 @@ std::string num(const Json& v) {
   if (v.is_null()) return "null";
   if (v.is_array()) {
     std::string s;
-    for (const Json& x : v) s += (s.empty() ? "" : ", ") + num(x);
+    for (const PageJson& x : v) s += (s.empty() ? "" : ", ") + num(x);
     return "(" + s + ")";
   }
   return v.dump();
 }
 
 // j[key] if j is an object holding it, else null
-const Json& at(const Json& j, const char* key) {
-  static const Json kNull;
+const PageJson& at(const PageJson& j, const char* key) {
+  static const PageJson kNull;
   if (!j.is_object()) return kNull;
   const auto it = j.find(key);
   return it == j.end() ? kNull : *it;
@@ -81,7 +81,7 @@ std::string csv_table(const std::string& csv, const std::string& cls) {
         // numbers shortened; text as it is
         char* end = nullptr;
         const double v = std::strtod(c.c_str(), &end);
-        s += td(!c.empty() && end != nullptr && *end == '\0' ? num(Json(v)) : c);
+        s += td(!c.empty() && end != nullptr && *end == '\0' ? num(PageJson(v)) : c);
       }
     }
     s += "</tr>\n";
@@ -114,21 +114,21 @@ const char* const kStyle =
     "text-decoration:none}details{display:block}div.scroll{overflow:visible}}";
 
 // the case's key parameters first, every one in a fold below
-std::string parameters(const Json& summary) {
-  const Json& params = at(summary, "parameters");
+std::string parameters(const PageJson& summary) {
+  const PageJson& params = at(summary, "parameters");
   std::string s = "<table class=\"params\">\n<tr>" + th("parameter") +
                   th("value") + th("unit") + th("source") + "</tr>\n";
   const char* const key[] = {"vm_kind",        "vm_pivot_mm",     "vm_length_mm",
                              "k_pos_N_per_mm", "k_ornt_multiple", "error",
                              "servo_period_s", "duration_s"};
-  auto row = [&](const std::string& name, const Json& p) {
+  auto row = [&](const std::string& name, const PageJson& p) {
     return "<tr>" + td(name) + td(num(at(p, "value"))) +
            td(num(at(p, "unit"))) + td(num(at(p, "source"))) + "</tr>\n";
   };
   for (const char* k : key) {
     if (!at(params, k).is_null()) s += row(k, at(params, k));
   }
-  const Json& phys = at(summary, "physics");
+  const PageJson& phys = at(summary, "physics");
   s += "<tr>" + td("physics step_s, integrator") +
        td(num(at(phys, "step_s")) + ", " + num(at(phys, "integrator"))) +
        td("s") + td("scene") + "</tr>\n</table>\n";
@@ -144,14 +144,14 @@ std::string parameters(const Json& summary) {
 }
 
 // "value comparison threshold unit (law: prediction, agrees)" in one cell
-std::string measured_cell(const Json& c, const Json& side) {
+std::string measured_cell(const PageJson& c, const PageJson& side) {
   std::string v = num(at(side, "value")) + " " + num(at(c, "comparison")) +
                   " " + num(at(c, "threshold"));
-  const Json& unit = at(c, "unit");
+  const PageJson& unit = at(c, "unit");
   if (unit.is_string() && !unit.get<std::string>().empty()) v += " " + num(unit);
   if (!at(side, "prediction").is_null()) {
     v += " (law: " + num(at(side, "prediction"));
-    const Json& m = at(side, "matches_prediction");
+    const PageJson& m = at(side, "matches_prediction");
     if (m.is_boolean()) v += m.get<bool>() ? ", agrees" : ", differs";
     v += ")";
   }
@@ -159,12 +159,12 @@ std::string measured_cell(const Json& c, const Json& side) {
 }
 
 // the verdict: pass, FAIL, or partial naming the sides where it fails
-std::string verdict_text(const Json& c) {
-  const Json& verdict = at(c, "pass");
+std::string verdict_text(const PageJson& c) {
+  const PageJson& verdict = at(c, "pass");
   if (verdict.is_boolean()) return verdict.get<bool>() ? "pass" : "FAIL";
   std::string failing;
-  for (const Json& side : at(c, "sides")) {
-    const Json& p = at(side, "pass");
+  for (const PageJson& side : at(c, "sides")) {
+    const PageJson& p = at(side, "pass");
     if (p.is_boolean() && !p.get<bool>()) {
       failing += (failing.empty() ? "" : "; ") + num(at(side, "where"));
     }
@@ -172,27 +172,27 @@ std::string verdict_text(const Json& c) {
   return "partial: fails " + (failing.empty() ? std::string("on a side") : failing);
 }
 
-std::string verdict_class(const Json& c) {
-  const Json& verdict = at(c, "pass");
+std::string verdict_class(const PageJson& c) {
+  const PageJson& verdict = at(c, "pass");
   if (verdict.is_boolean()) return verdict.get<bool>() ? "pass" : "fail";
   return "partial";
 }
 
-std::string claim_anchor(const std::string& case_name, const Json& c) {
+std::string claim_anchor(const std::string& case_name, const PageJson& c) {
   return case_name + "-claim-" + num(at(c, "name"));
 }
 
-std::string claims_table(const std::string& case_name, const Json& summary) {
+std::string claims_table(const std::string& case_name, const PageJson& summary) {
   std::string s = "<table class=\"claims\">\n<tr>" + th("claim") +
                   th("what the thesis says") + th("verdict") +
                   th("measured vs threshold (law's prediction)") +
                   th("each side: measured (prediction), verdict") +
                   th("regime") + th("window") + "</tr>\n";
-  for (const Json& c : at(summary, "claims")) {
+  for (const PageJson& c : at(summary, "claims")) {
     const std::string cls = verdict_class(c);
     std::string sides;
-    for (const Json& side : at(c, "sides")) {
-      const Json& p = at(side, "pass");
+    for (const PageJson& side : at(c, "sides")) {
+      const PageJson& p = at(side, "pass");
       const bool ok = p.is_boolean() && p.get<bool>();
       sides += "<li" + std::string(ok ? "" : " class=\"fail\"") + ">" +
                escape(num(at(side, "where")) + ": " + measured_cell(c, side) +
@@ -210,7 +210,7 @@ std::string claims_table(const std::string& case_name, const Json& summary) {
 }
 
 std::string case_section(const ReportCase& c) {
-  const Json& m = at(c.summary, "metrics");
+  const PageJson& m = at(c.summary, "metrics");
   std::string s = "<section id=\"" + escape(c.name) + "\">\n<h2>" +
                   escape(c.name) + ": thesis case " +
                   escape(num(at(c.summary, "thesis_case"))) + "</h2>\n";
@@ -259,9 +259,9 @@ std::string run_time_table(const std::vector<ReportCase>& cases) {
                   th("max_path_error_mm") + th("mean_force_N") +
                   th("claims passed") + "</tr>\n";
   for (const ReportCase& c : cases) {
-    const Json& m = at(c.summary, "metrics");
+    const PageJson& m = at(c.summary, "metrics");
     int pass = 0, total = 0, failed = 0;
-    for (const Json& k : at(c.summary, "claims")) {
+    for (const PageJson& k : at(c.summary, "claims")) {
       ++total;
       pass += at(k, "pass").is_boolean() && at(k, "pass").get<bool>() ? 1 : 0;
       failed += at(k, "pass").is_boolean() && !at(k, "pass").get<bool>() ? 1 : 0;
@@ -301,16 +301,16 @@ std::string pass_means(const std::string& outcome) {
   return "failed: " + outcome;
 }
 
-std::string extremes_table(const Json& ex) {
+std::string extremes_table(const PageJson& ex) {
   std::string s = "<table class=\"extremes\">\n<tr>" + th("scenario") +
                   th("stresses") + th("outcome") + th("pass") +
                   th("what pass means here") +
                   th("max_force_N") + th("force_limit_N") +
                   th("energy motor_max_J") + th("energy rest_rise_J") +
                   th("wall_time_s") + "</tr>\n";
-  for (const Json& r : at(ex, "scenarios")) {
+  for (const PageJson& r : at(ex, "scenarios")) {
     const bool pass = at(r, "pass").is_boolean() && at(r, "pass").get<bool>();
-    const Json& e = at(r, "energy");
+    const PageJson& e = at(r, "energy");
     s += std::string(pass ? "<tr>" : "<tr class=\"fail\">") +
          td(num(at(r, "name"))) + td(num(at(r, "stresses"))) +
          td(num(at(r, "outcome"))) +
@@ -384,9 +384,9 @@ std::string read_file_text(const std::string& path) {
 ClaimTally tally_claims(const std::vector<ReportCase>& cases) {
   ClaimTally t;
   for (const ReportCase& c : cases) {
-    for (const Json& k : at(c.summary, "claims")) {
+    for (const PageJson& k : at(c.summary, "claims")) {
       ++t.total;
-      const Json& v = at(k, "pass");
+      const PageJson& v = at(k, "pass");
       if (v.is_boolean() && v.get<bool>()) {
         ++t.passed;
       } else if (v.is_string() && v.get<std::string>() == "partial") {
@@ -462,7 +462,7 @@ std::string inline_svg(const std::string& svg_document,
 std::string claim_matrix(const std::vector<ReportCase>& cases) {
   std::vector<std::string> names;
   for (const ReportCase& c : cases) {
-    for (const Json& k : at(c.summary, "claims")) {
+    for (const PageJson& k : at(c.summary, "claims")) {
       const std::string n = num(at(k, "name"));
       if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
     }
@@ -475,8 +475,8 @@ std::string claim_matrix(const std::vector<ReportCase>& cases) {
   for (const std::string& n : names) {
     s += "<tr>" + td(n);
     for (const ReportCase& c : cases) {
-      const Json* claim = nullptr;
-      for (const Json& k : at(c.summary, "claims")) {
+      const PageJson* claim = nullptr;
+      for (const PageJson& k : at(c.summary, "claims")) {
         if (num(at(k, "name")) == n) claim = &k;
       }
       if (claim == nullptr) {
@@ -579,7 +579,7 @@ std::string report_html(const ReportInputs& in) {
   s += "<tr>" + th("generated (UTC)") + td(h.generated_utc) + "</tr>\n";
   s += "<tr>" + th("command line") + td(h.command_line) + "</tr>\n";
   s += "<tr>" + th("cores") + td(std::to_string(h.cores)) + "</tr>\n";
-  s += "<tr>" + th("wall time (s)") + td(num(Json(h.wall_s))) + "</tr>\n";
+  s += "<tr>" + th("wall time (s)") + td(num(PageJson(h.wall_s))) + "</tr>\n";
   s += "<tr>" + th("ran") + td(list_text(h.ran)) + "</tr>\n";
   s += "<tr>" + th("reused from disk") + td(list_text(h.reused)) + "</tr>\n";
   s += "</table>\n</section>\n";

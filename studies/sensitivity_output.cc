@@ -20,7 +20,7 @@ using Json = nlohmann::ordered_json;
 using sim::SimError;
 namespace fs = std::filesystem;
 
-Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(); }
+Json sens_number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(); }
 double number_from(const nlohmann::json& j) {
   return j.is_number() ? j.get<double>() : std::nan("");
 }
@@ -177,7 +177,7 @@ struct Range {
     hi = std::isfinite(hi) ? std::max(hi, x) : x;
   }
   double span() const { return std::isfinite(lo) ? hi - lo : 0.0; }
-  Json json() const { return Json::array({number_or_null(lo), number_or_null(hi)}); }
+  Json json() const { return Json::array({sens_number_or_null(lo), sens_number_or_null(hi)}); }
 };
 
 // a level's distance from the nominal on the parameter's own scale, 0..1
@@ -229,8 +229,8 @@ nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
     }
     Json claims = Json::object();
     for (const ClaimOutcome& c : r.claims) {
-      claims[c.name] = {{"value", number_or_null(c.value)},
-                        {"margin", number_or_null(claim_margin(c))},
+      claims[c.name] = {{"value", sens_number_or_null(c.value)},
+                        {"margin", sens_number_or_null(claim_margin(c))},
                         {"pass", c.pass}};
     }
     points.push_back(
@@ -241,7 +241,7 @@ nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
                                         : Json(plan.parameters[static_cast<std::size_t>(pt.parameter)].name)},
          {"values", values},
          {"set", pt.overrides},
-         {"rms_path_error_mm", number_or_null(r.rms_path_error_mm)},
+         {"rms_path_error_mm", sens_number_or_null(r.rms_path_error_mm)},
          {"error", r.error.empty() ? Json() : Json(r.error)},
          {"claims", claims}});
   }
@@ -290,7 +290,7 @@ nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
       Json by_parameter = Json::array();
       for (const ParameterEffect& e : effects) {
         by_parameter.push_back({{"parameter", plan.parameters[e.parameter].name},
-                                {"holds_fraction", number_or_null(e.holds_fraction)},
+                                {"holds_fraction", sens_number_or_null(e.holds_fraction)},
                                 {"value_range", e.value.json()},
                                 {"margin_range", e.margin.json()}});
       }
@@ -318,14 +318,14 @@ nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
            {"unit", cv.unit},
            {"comparison", cv.comparison},
            {"threshold", cv.threshold},
-           {"value_at_nominal", nc != nullptr ? number_or_null(nc->value) : Json()},
+           {"value_at_nominal", nc != nullptr ? sens_number_or_null(nc->value) : Json()},
            {"holds_at_nominal", nominal_holds},
-           {"holds_fraction", number_or_null(fraction_holding(over, results, cv.name))},
+           {"holds_fraction", sens_number_or_null(fraction_holding(over, results, cv.name))},
            {"holds_fraction_over", sampled ? "sample" : "one_at_a_time"},
            {"holds_fraction_one_at_a_time",
-            number_or_null(fraction_holding(oat, results, cv.name))},
+            sens_number_or_null(fraction_holding(oat, results, cv.name))},
            {"holds_fraction_sample",
-            sampled ? number_or_null(fraction_holding(cp.sample, results, cv.name))
+            sampled ? sens_number_or_null(fraction_holding(cp.sample, results, cv.name))
                     : Json()},
            {"depends_on", depends_on},
            {"by_parameter", by_parameter}});
@@ -350,9 +350,9 @@ nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
     spreads.push_back(
         {{"case", c.name},
          {"rms_path_error_mm",
-          {{"nominal", number_or_null(results[cp.nominal].rms_path_error_mm)},
-           {"min", number_or_null(all.lo)},
-           {"max", number_or_null(all.hi)},
+          {{"nominal", sens_number_or_null(results[cp.nominal].rms_path_error_mm)},
+           {"min", sens_number_or_null(all.lo)},
+           {"max", sens_number_or_null(all.hi)},
            {"spread", all.span()},
            {"over", sampled ? "sample" : "one_at_a_time"},
            {"points", over.size()}}},
@@ -496,13 +496,13 @@ nlohmann::ordered_json partial_json(const SweepPlan& plan, int k, int n,
   for (const PointResult& r : results) {
     Json claims = Json::array();
     for (const ClaimOutcome& c : r.claims) {
-      claims.push_back({{"name", c.name}, {"value", number_or_null(c.value)},
+      claims.push_back({{"name", c.name}, {"value", sens_number_or_null(c.value)},
                         {"threshold", c.threshold}, {"comparison", c.comparison},
                         {"unit", c.unit}, {"pass", c.pass}});
     }
     rs.push_back({{"index", r.index},
                   {"error", r.error},
-                  {"rms_path_error_mm", number_or_null(r.rms_path_error_mm)},
+                  {"rms_path_error_mm", sens_number_or_null(r.rms_path_error_mm)},
                   {"claims", claims}});
   }
   return {{"study", "sensitivity-partial"},

@@ -18,7 +18,7 @@ namespace vmh::studies {
 using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using constants::kPi;
 
 std::string str(double v) {
   std::ostringstream s;

@@ -27,7 +27,7 @@ constexpr double kPlane_px = 340.0;
 const char* const kV = "#d62728";
 const char* const kR = "#2ca02c";
 
-std::string num(double v) {
+std::string thesis_num(double v) {
   std::string s = format("%.3g", v);
   return s == "-0" ? "0" : s;
 }
@@ -84,14 +84,14 @@ std::string time_plot(const std::vector<ThesisSample>& s, std::size_t k,
     g += "<line" + attr("x1", px(kLeft_px - 4)) + attr("y1", px(Y(v))) +
          attr("x2", px(kLeft_px)) + attr("y2", px(Y(v))) + " stroke=\"#444\"/>\n";
     g += "<text" + attr("x", px(kLeft_px - 6)) + attr("y", px(Y(v) + 4)) +
-         " text-anchor=\"end\">" + num(std::abs(v) < 1e-9 * ystep ? 0.0 : v) + "</text>\n";
+         " text-anchor=\"end\">" + thesis_num(std::abs(v) < 1e-9 * ystep ? 0.0 : v) + "</text>\n";
   }
   const double tstep = nice_step(t1 - t0, 8.0);
   for (double t = std::ceil(t0 / tstep) * tstep; t <= t1 + 1e-9; t += tstep) {
     g += "<line" + attr("x1", px(X(t))) + attr("y1", px(top + kPlotH_px)) +
          attr("x2", px(X(t))) + attr("y2", px(top + kPlotH_px + 4)) + " stroke=\"#444\"/>\n";
     g += "<text" + attr("x", px(X(t))) + attr("y", px(top + kPlotH_px + 16)) +
-         " text-anchor=\"middle\">" + num(t) + "</text>\n";
+         " text-anchor=\"middle\">" + thesis_num(t) + "</text>\n";
   }
   if (last) {
     g += "<text" + attr("x", px(kLeft_px + width / 2)) + attr("y", px(top + kPlotH_px + 32)) +
@@ -168,7 +168,7 @@ std::string plane_plot(const std::vector<ThesisSample>& s, const ForceFieldPath&
   for (int axis = 0; axis < 2; ++axis) {
     const double c = axis == 0 ? c0 : c1;
     for (double t = std::ceil((c - span / 2) / step) * step; t <= c + span / 2; t += step) {
-      const std::string label = num(std::abs(t) < 1e-9 * step ? 0.0 : t);
+      const std::string label = thesis_num(std::abs(t) < 1e-9 * step ? 0.0 : t);
       if (axis == 0) {
         g += "<line" + attr("x1", px(X(t))) + attr("y1", px(top + kPlane_px)) +
              attr("x2", px(X(t))) + attr("y2", px(top + kPlane_px + 4)) + " stroke=\"#444\"/>\n";
@@ -216,8 +216,8 @@ std::string plane_plot(const std::vector<ThesisSample>& s, const ForceFieldPath&
          attr("width", "12") + attr("height", px(bh / 50 + 0.5)) +
          attr("fill", time_colour((i + 0.5) / 50)) + "/>\n";
   }
-  g += "<text" + attr("x", px(bx + 16)) + attr("y", px(top + bh)) + ">" + num(t0) + " s</text>\n";
-  g += "<text" + attr("x", px(bx + 16)) + attr("y", px(top + 10)) + ">" + num(t1) + " s</text>\n";
+  g += "<text" + attr("x", px(bx + 16)) + attr("y", px(top + bh)) + ">" + thesis_num(t0) + " s</text>\n";
+  g += "<text" + attr("x", px(bx + 16)) + attr("y", px(top + 10)) + ">" + thesis_num(t1) + " s</text>\n";
   return g + "</g>\n";
 }
 

@@ -18,10 +18,10 @@
 namespace vmh::bringup {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using constants::kPi;
 const double kNan = std::nan("");
 
-std::string fmt(double v, int precision = 3) {
+std::string force_fmt(double v, int precision = 3) {
   std::ostringstream s;
   s.precision(precision);
   s << v;
@@ -121,7 +121,7 @@ std::string find_pulse(const Recording& rec, const ReadingMap& map,
     }
   }
   if (best == w->t_s.size()) {
-    return "no good reading in the " + fmt(o.pre_ms) + " ms before the pulse";
+    return "no good reading in the " + force_fmt(o.pre_ms) + " ms before the pulse";
   }
   w->sim_start = best;
   return {};
@@ -267,7 +267,7 @@ void write_figure(const PulseWindow& w, const SimulatedResponse& nominal,
                   CompareSection* s) {
   report::ChartGrid g;
   g.title = "force direction: motor " + std::to_string(w.motor) + " pulse, " +
-            fmt(1e3 * w.pulse_s) + " ms";
+            force_fmt(1e3 * w.pulse_s) + " ms";
   g.notes.push_back(
       "device joints t1..t3 (rad), measured through the reading map; "
       "time from the pulse's start (ms)");
@@ -415,21 +415,21 @@ CompareSection compare_force_direction(const Recording& rec,
       s.skipped.push_back(
           {prefix + c,
            "the prediction moves t1..t3 less than " +
-               fmt(kMinEffect_rad * 1e3) +
+               force_fmt(kMinEffect_rad * 1e3) +
                " mrad (three encoder counts): a pulse into a joint limit or "
                "below the friction; ask a larger torque or another pose",
            rec.dir});
     }
   }
 
-  const std::string at_lag = " at the fitted lag " + fmt(lag_ms) + " ms";
+  const std::string at_lag = " at the fitted lag " + force_fmt(lag_ms) + " ms";
   bool gain_failed = false;
   if (observable) {
     s.checks.push_back(make_check(prefix + "_angle", nominal_fit.angle_deg,
                                   o.angle_max_deg, "deg", CompareCheck::kAtMost,
                                   "angle between measured and predicted t1..t3 "
                                   "motion over the response's first " +
-                                      fmt(1e3 * (t1_fit_s - t0_fit_s)) + " ms" +
+                                      force_fmt(1e3 * (t1_fit_s - t0_fit_s)) + " ms" +
                                       at_lag));
     const CompareCheck gain_lo =
         make_check(prefix + "_gain", nominal_fit.gain, o.gain_min, "ratio",
@@ -438,16 +438,16 @@ CompareSection compare_force_direction(const Recording& rec,
         prefix + "_gain", nominal_fit.gain, o.gain_max, "ratio",
         CompareCheck::kAtMost,
         "least-squares measured/predicted amplitude" + at_lag +
-            ", pass within [" + fmt(o.gain_min) + ", " + fmt(o.gain_max) + "]");
+            ", pass within [" + force_fmt(o.gain_min) + ", " + force_fmt(o.gain_max) + "]");
     gain.pass = gain.pass && gain_lo.pass;
     gain_failed = !gain.pass;
     s.checks.push_back(gain);
     s.checks.push_back(
         make_check(prefix + "_lag", lag_ms, o.lag_baseline_ms + o.lag_excess_ms,
                    "ms", CompareCheck::kAtMost,
-                   "extra delay (0.." + fmt(o.lag_max_ms) +
+                   "extra delay (0.." + force_fmt(o.lag_max_ms) +
                        " ms) that best fits; a clean recording shows " +
-                       fmt(o.lag_baseline_ms) + " ms"));
+                       force_fmt(o.lag_baseline_ms) + " ms"));
   }
   for (CompareCheck& c : s.checks) c.recording = rec.dir;
 
@@ -495,8 +495,8 @@ CompareSection compare_force_direction(const Recording& rec,
       // moved without a prediction to judge it by: nothing to name
     } else if (named != nullptr) {
       fault = named->name;
-      evidence = named->name + " fits with rms " + fmt(named->rms_rad) +
-                 " rad against the nominal's " + fmt(rms0) + " rad";
+      evidence = named->name + " fits with rms " + force_fmt(named->rms_rad) +
+                 " rad against the nominal's " + force_fmt(rms0) + " rad";
     } else if (nominal_fit.gain > 10.0) {
       fault = "torque_units_Nm";
     } else if (nominal_fit.gain < 0.1) {
@@ -510,8 +510,8 @@ CompareSection compare_force_direction(const Recording& rec,
               std::to_string(std::lround(lag_ms - o.lag_baseline_ms)) + "ms";
     }
     if (evidence.empty()) {
-      evidence = "angle " + fmt(nominal_fit.angle_deg) + " deg, gain " +
-                 fmt(nominal_fit.gain) + ", lag " + fmt(lag_ms) +
+      evidence = "angle " + force_fmt(nominal_fit.angle_deg) + " deg, gain " +
+                 force_fmt(nominal_fit.gain) + ", lag " + force_fmt(lag_ms) +
                  " ms; no alternative fits clearly better";
     }
     if (!fault.empty()) s.faults.push_back({fault, evidence, rec.dir});
@@ -617,7 +617,7 @@ CompareSection compare_force_mapping(const Recording& run) {
               {"p95_deg_by_reading", readings}};
   if (!c.pass) {
     s.faults.push_back({"force_mapping",
-                        "p95 angle " + fmt(p95[best]) +
+                        "p95 angle " + force_fmt(p95[best]) +
                             " deg between the project's and the device's J^T F",
                         run.dir});
   }

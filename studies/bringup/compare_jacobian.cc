@@ -44,7 +44,7 @@ Mat6 dh_per_device_joint() {
   return M;
 }
 
-std::string fmt(const char* f, double a) {
+std::string jac_fmt(const char* f, double a) {
   char buf[160];
   std::snprintf(buf, sizeof buf, f, a);
   return buf;
@@ -164,7 +164,7 @@ CompareSection compare_jacobian(const Recording& rec, const ReadingMap& readings
     if (rel.size() < kMinSamples) {
       sec.skipped.push_back(
           {name, std::to_string(rel.size()) + " samples move faster than " +
-                     fmt("%.0f mm/s", kVelocityMinSpeedMmS) + ", at least " +
+                     jac_fmt("%.0f mm/s", kVelocityMinSpeedMmS) + ", at least " +
                      std::to_string(kMinSamples) + " needed",
            rec.dir});
       return;
@@ -173,7 +173,7 @@ CompareSection compare_jacobian(const Recording& rec, const ReadingMap& readings
         name, median(rel), kVelocityRelErrorThreshold, "ratio", CompareCheck::kAtMost,
         "median |J qdot - " + against + "| / |" + against + "| over " +
             std::to_string(rel.size()) + " samples faster than " +
-            fmt("%.0f mm/s", kVelocityMinSpeedMmS)));
+            jac_fmt("%.0f mm/s", kVelocityMinSpeedMmS)));
   };
   if (rec.has_velocity()) velocity_check("jacobian.velocity_rel_error", rel_v, "dev_v");
   if (has_p) velocity_check("jacobian.fd_velocity_rel_error", rel_fd, "d(dev_p)/dt");

@@ -15,7 +15,7 @@
 namespace vmh::bringup {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using constants::kPi;
 constexpr double kRadToDeg = 180.0 / kPi;
 // a hypothesis other than the identity must beat it by this factor
 constexpr double kClearlyBetter = 3.0;
@@ -30,7 +30,7 @@ constexpr std::size_t kHypothesisSamples = 400;
 // recordings); a wrong one is not worth polishing
 constexpr int kHypothesisIterations = 15;
 
-std::string fmt(const char* f, double a, double b = 0, double c = 0) {
+std::string kin_fmt(const char* f, double a, double b = 0, double c = 0) {
   char buf[200];
   std::snprintf(buf, sizeof buf, f, a, b, c);
   return buf;
@@ -93,8 +93,8 @@ std::vector<SuspectedFault> geometry_faults(const GeometryFit& f) {
     if (!significant(p, kLinkRelative * p.nominal)) continue;
     const double pct = 100.0 * (p.fitted / p.nominal - 1.0);
     out.push_back({"link_length_" + std::to_string(static_cast<int>(std::lround(pct))) + "pct",
-                   p.name + fmt(" fitted %.2f mm (nominal %.2f, sigma %.3f mm)", p.fitted,
-                                p.nominal, p.sigma) + fmt(", %+.2f %%", pct),
+                   p.name + kin_fmt(" fitted %.2f mm (nominal %.2f, sigma %.3f mm)", p.fitted,
+                                p.nominal, p.sigma) + kin_fmt(", %+.2f %%", pct),
                    {}});
   }
   if (!out.empty()) return out;
@@ -102,13 +102,13 @@ std::vector<SuspectedFault> geometry_faults(const GeometryFit& f) {
     const FittedParam& p = f.params[kOffsetT1 + i];
     if (!significant(p, kJointOffsetRad)) continue;
     out.push_back({"joint" + std::to_string(i + 1) + "_offset",
-                   p.name + fmt(" fitted %.4f rad (sigma %.4f rad)", p.fitted, p.sigma), {}});
+                   p.name + kin_fmt(" fitted %.4f rad (sigma %.4f rad)", p.fitted, p.sigma), {}});
   }
   for (int i = 0; i < 3; ++i) {
     const FittedParam& p = f.params[kScaleT4 + i];
     if (!significant(p, kGimbalScaleRelative)) continue;
     out.push_back({"joint" + std::to_string(i + 4) + "_scale",
-                   p.name + fmt(" fitted %.4f (sigma %.4f)", p.fitted, p.sigma), {}});
+                   p.name + kin_fmt(" fitted %.4f (sigma %.4f)", p.fitted, p.sigma), {}});
   }
   Vec3 b, sb;
   for (int k = 0; k < 3; ++k) {
@@ -116,7 +116,7 @@ std::vector<SuspectedFault> geometry_faults(const GeometryFit& f) {
     sb[k] = f.params[kBaseX + k].sigma;
   }
   if (b.norm() > kBaseOffsetMm && b.norm() > kSigmas * sb.norm()) {
-    out.push_back({"base_offset", fmt("base offset fitted (%.2f, %.2f, %.2f) mm, device frame",
+    out.push_back({"base_offset", kin_fmt("base offset fitted (%.2f, %.2f, %.2f) mm, device frame",
                                       b[0], b[1], b[2]), {}});
   }
   return out;
@@ -188,12 +188,12 @@ ReadingDiagnosis diagnose_readings(const Recording& rec) {
     }
   }
   d.map = best->map;
-  d.evidence = "identity: position p95 " + fmt("%.2f mm, rotation p95 %.2f deg after the fit",
+  d.evidence = "identity: position p95 " + kin_fmt("%.2f mm, rotation p95 %.2f deg after the fit",
                                                id.fit.position_after_mm.p95,
                                                id.fit.rotation_after_deg.p95);
   if (best != &id) {
     d.evidence += "; " + best->map.name +
-                  fmt(": %.2f mm, %.2f deg (%.0fx lower)", best->fit.position_after_mm.p95,
+                  kin_fmt(": %.2f mm, %.2f deg (%.0fx lower)", best->fit.position_after_mm.p95,
                       best->fit.rotation_after_deg.p95,
                       id.normalized_p95 / std::max(best->normalized_p95, 1e-12));
   }
@@ -341,10 +341,10 @@ CompareSection compare_kinematics(const Recording& rec, const std::string& figur
     if (sec.faults.empty()) {
       sec.faults.push_back(
           {"kinematics_unexplained",
-           fmt("position p95 %.2f mm, stylus axis p95 %.2f deg; after the geometry fit "
+           kin_fmt("position p95 %.2f mm, stylus axis p95 %.2f deg; after the geometry fit "
                "%.2f mm",
                pos.p95, axis.p95, fit.position_after_mm.p95) +
-               fmt(", %.2f deg: no reading map or geometry explains it",
+               kin_fmt(", %.2f deg: no reading map or geometry explains it",
                    fit.rotation_after_deg.p95),
            {}});
     }

@@ -13,7 +13,7 @@
 namespace vmh::bringup {
 namespace {
 
-std::string fmt(double v, int precision = 4) {
+std::string replay_fmt(double v, int precision = 4) {
   std::ostringstream s;
   s.precision(precision);
   s << v;
@@ -85,8 +85,8 @@ CompareCheck ratio_check(const std::string& name, double value,
                          const ReplayOptions& o, const std::string& detail) {
   CompareCheck c =
       make_check(name, value, o.ratio_max, "ratio", CompareCheck::kAtMost,
-                 detail + "; pass within [" + fmt(o.ratio_min) + ", " +
-                     fmt(o.ratio_max) + "]");
+                 detail + "; pass within [" + replay_fmt(o.ratio_min) + ", " +
+                     replay_fmt(o.ratio_max) + "]");
   c.pass = c.pass && value >= o.ratio_min;
   return c;
 }
@@ -153,10 +153,10 @@ void replay(const Recording& r, const ControllerParams& params,
   if (first >= 0) {
     const auto row = static_cast<std::size_t>(first);
     detail += "; first differing row " + std::to_string(first) + " (t_s " +
-              fmt(r.t_s(row), 6) + "): recorded " + fmt(1e3 * first_rec[0]) +
-              ", " + fmt(1e3 * first_rec[1]) + ", " + fmt(1e3 * first_rec[2]) +
-              " mN m, replayed " + fmt(1e3 * first_rep[0]) + ", " +
-              fmt(1e3 * first_rep[1]) + ", " + fmt(1e3 * first_rep[2]) +
+              replay_fmt(r.t_s(row), 6) + "): recorded " + replay_fmt(1e3 * first_rec[0]) +
+              ", " + replay_fmt(1e3 * first_rec[1]) + ", " + replay_fmt(1e3 * first_rec[2]) +
+              " mN m, replayed " + replay_fmt(1e3 * first_rep[0]) + ", " +
+              replay_fmt(1e3 * first_rep[1]) + ", " + replay_fmt(1e3 * first_rep[2]) +
               " mN m";
     d["first_differing_row"] = {
         {"row", first},
@@ -196,19 +196,19 @@ void simulate(const Recording& r, const std::string& scene,
     return;
   }
   const double duration_s = rec.t_s.back();
-  overrides.push_back("duration_s=" + fmt(std::max(duration_s, 1e-3), 9));
+  overrides.push_back("duration_s=" + replay_fmt(std::max(duration_s, 1e-3), 9));
   // the gains as hw run scaled them, in the scene's own parameters
   {
     const sim::ClosedLoop probe(scene, overrides);
     const sim::ControllerSettings& cs = probe.config().controller;
     overrides.push_back("k_pos_N_per_mm=" +
-                        fmt(gain_scale * cs.k_pos_N_per_mm, 17));
+                        replay_fmt(gain_scale * cs.k_pos_N_per_mm, 17));
     overrides.push_back("k_ornt_multiple=" +
-                        fmt(gain_scale * cs.k_ornt_multiple, 17));
+                        replay_fmt(gain_scale * cs.k_ornt_multiple, 17));
     overrides.push_back("k_vel_Ns_per_mm=" +
-                        fmt(gain_scale * cs.k_vel_Ns_per_mm, 17));
+                        replay_fmt(gain_scale * cs.k_vel_Ns_per_mm, 17));
     overrides.push_back("k_vel_ornt_Nmms_per_rad=" +
-                        fmt(gain_scale * cs.k_vel_ornt_Nmms_per_rad, 17));
+                        replay_fmt(gain_scale * cs.k_vel_ornt_Nmms_per_rad, 17));
   }
   sim::ClosedLoop loop(scene, overrides);
   Series sim;
@@ -221,14 +221,14 @@ void simulate(const Recording& r, const std::string& scene,
   }
   const double e_ratio = rec.rms(rec.e_mm) / sim.rms(sim.e_mm);
   const double f_ratio = rec.rms(rec.F_N) / sim.rms(sim.F_N);
-  const std::string over = " over " + fmt(duration_s) + " s";
+  const std::string over = " over " + replay_fmt(duration_s) + " s";
   s->checks.push_back(ratio_check(
       "closed_loop.error_rms_ratio", e_ratio, o,
-      "RMS |e_1..3_mm| recorded " + fmt(rec.rms(rec.e_mm)) + " mm, simulated " +
-          fmt(sim.rms(sim.e_mm)) + " mm" + over));
+      "RMS |e_1..3_mm| recorded " + replay_fmt(rec.rms(rec.e_mm)) + " mm, simulated " +
+          replay_fmt(sim.rms(sim.e_mm)) + " mm" + over));
   s->checks.push_back(ratio_check("closed_loop.force_rms_ratio", f_ratio, o,
-                                  "RMS |F| recorded " + fmt(rec.rms(rec.F_N)) +
-                                      " N, simulated " + fmt(sim.rms(sim.F_N)) +
+                                  "RMS |F| recorded " + replay_fmt(rec.rms(rec.F_N)) +
+                                      " N, simulated " + replay_fmt(sim.rms(sim.F_N)) +
                                       " N" + over));
   for (std::size_t k = s->checks.size() - 2; k < s->checks.size(); ++k) {
     s->checks[k].recording = r.dir;
@@ -313,7 +313,7 @@ CompareSection compare_closed_loop(const Recording& r, const ReplayOptions& o,
                              : c.name == kAll[1] ? "closed_loop_error_level"
                                                  : "closed_loop_force_level";
     s.faults.push_back(
-        {name, c.name + " = " + fmt(c.value) + " " + c.unit + ": " + c.detail,
+        {name, c.name + " = " + replay_fmt(c.value) + " " + c.unit + ": " + c.detail,
          r.dir});
   }
   return s;

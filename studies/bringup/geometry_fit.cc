@@ -14,8 +14,8 @@
 namespace vmh::bringup {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kRadToDeg = 180.0 / kPi;
+using constants::kPi;
+constexpr double kFitRadToDeg = 180.0 / kPi;
 
 // The angle of a rotation from its skew and symmetric parts: acos of the
 // trace alone turns entry noise of 1e-4 into a degree near zero
@@ -51,7 +51,7 @@ bool snap_to_signed_permutation(Mat3* C) {
   if ((P.transpose() * P - Mat3::Identity()).norm() > 1e-9 || P.determinant() < 0) {
     return false;
   }
-  if (rotation_angle_rad(P.transpose() * *C) > 10.0 / kRadToDeg) return false;
+  if (rotation_angle_rad(P.transpose() * *C) > 10.0 / kFitRadToDeg) return false;
   *C = P;
   return true;
 }
@@ -69,7 +69,7 @@ Errors sample_errors(const GeometryVec& x, const Mat3& C,
     geometry_model(x, p.t_reported_device_rad, &pm, &Rm);
     e.position_mm.push_back((pm - p.p_device_mm).norm());
     e.rotation_deg.push_back(rotation_angle_rad((Rm * C).transpose() * p.R_device) *
-                             kRadToDeg);
+                             kFitRadToDeg);
   }
   return e;
 }
