@@ -25,11 +25,11 @@ struct UsageError : std::runtime_error {
 std::vector<double> parse_list(const std::string& option,
                                const std::string& text, int count);
 
-// Parses one finite number. Subnormal numbers (1e-320) are numbers; a
-// value that overflows to inf (1e999) is not.
 // `s` without its leading and trailing blanks (spaces and tabs)
 std::string trim(const std::string& s);
 
+// Parses one finite number. Subnormal numbers (1e-320) are numbers; a
+// value that overflows to inf (1e999) is not.
 double parse_number(const std::string& option, const std::string& text);
 
 // Gives every numeric option of `app` and its sub-verbs (CLI11's FLOAT, INT

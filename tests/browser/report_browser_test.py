@@ -145,8 +145,7 @@ class Chromium:
         height, about 4 s for the report's 30,000 px, against 0.1 s."""
         beyond = viewport is None or w > viewport[0] or h > viewport[1]
         if not beyond:
-            self.evaluate(session, f"window.scrollTo({x}, {y}), "
-                                   "[window.scrollX, window.scrollY]")
+            self.evaluate(session, f"window.scrollTo({x}, {y})")
         r = self.call("Page.captureScreenshot",
                       {"format": "png", "captureBeyondViewport": beyond,
                        "clip": {"x": x, "y": y, "width": w, "height": h,
