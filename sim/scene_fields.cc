@@ -134,7 +134,14 @@ class SceneReader {
       }
       const fs::path p = fs::path(*file).is_absolute() ? fs::path(*file)
                                                       : main_dir_ / *file;
-      read(p.string(), in_custom, depth + 1);
+      // a refusal inside the included file names the file that included
+      // it and where, up to the scene given: an absolute include may lie
+      // anywhere, and its name alone does not say which scene failed
+      try {
+        read(p.string(), in_custom, depth + 1);
+      } catch (const ParamError& e) {
+        fail(path, text, pos, "<include file=\"" + *file + "\">: " + e.what());
+      }
       return;
     }
     if (!in_custom || (name != "numeric" && name != "text")) return;
