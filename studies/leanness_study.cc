@@ -182,11 +182,13 @@ std::vector<VariantLoop> make_loops(const std::string& scene,
     v.result.variant = variant;
     v.result.wall_time_s = std::numeric_limits<double>::infinity();
     v.result.cpu_time_s = std::numeric_limits<double>::infinity();
-    // The case scenes size MuJoCo's stack for their few constraint rows
-    // (<size nstack>); with contacts on, every geom may touch every other
-    // and the solver's rows need MuJoCo's own default, 1.28 million
-    // mjtNums. The stack is allocated by mj_makeData from m->nstack, so
-    // it may be raised after compiling (nothing else is sized from it).
+    // The case scenes size mjData for their few constraint rows (<size
+    // njmax nconmax nstack>, models/cases/README.md), with room for the
+    // 26 rows and 5 contacts this variant has been seen to make; its stack
+    // is raised to MuJoCo's own default, 1.28 million mjtNums, so that the
+    // solver's scratch never runs out whatever the contacts. The stack is
+    // allocated by mj_makeData from m->nstack, so it may be raised after
+    // compiling (nothing else is sized from it); njmax and nconmax may not.
     ModelHook hook;
     if (variant.ingredients & kContacts) {
       hook = [](mjModel* m) { m->nstack = std::max(m->nstack, kMujocoDefaultStack); };
