@@ -112,10 +112,11 @@ TEST(TraceWriter, EveryRowHasTheHeadersCellsAndTheRecordsValues) {
   EXPECT_EQ(d[static_cast<std::size_t>(index_of(cols, "phase"))], "");
 }
 
-// The numbers are written by std::to_chars; their text must be printf's
-// "%.9g" (what the trace wrote before, and what readers of it were checked
-// on), over magnitudes from denormals to 1e300, both signs, the values
-// with nine and fewer digits, and the non-finite ones.
+// The numbers are written by a scaled-integer path or by std::to_chars;
+// their text must be printf's "%.9g" (what the trace wrote before, and what
+// readers of it were checked on), over magnitudes from denormals to 1e300,
+// both signs, the values with nine and fewer digits, and the non-finite
+// ones.
 TEST(TraceWriter, NumbersAreWrittenAsPrintfWritesThem) {
   TraceLayout bare;
   const auto cols = trace_columns(bare);
@@ -135,6 +136,27 @@ TEST(TraceWriter, NumbersAreWrittenAsPrintfWritesThem) {
     if (i % 2) v = -v;
     if (i % 5 == 0) v = std::round(v * 1e4) / 1e4;  // few digits
     values.push_back(v);
+  }
+  // where the trace's numbers are (1e-14..1e30 is written without
+  // std::to_chars): at the switches between fixed and scientific text,
+  // where rounding carries into a new digit, at and near ties of the ninth
+  // digit, and with nine or ten significant digits
+  for (double v : {1e-5, 9.99999999e-5, 9.999999995e-5, 1e-4, 0.0001000000005,
+                   99999999.95, 99999999.94999, 999999999.4, 999999999.5,
+                   999999999.6, 1e9, 1e-14, 9.99999e-15, 1e30, 9.9999999e29,
+                   1.234567885, 1.2345678850000001, 0.5, 2.5, 123456789.5,
+                   0.1234567895, 44.030070349999, 1.00000000049999}) {
+    values.push_back(v);
+    values.push_back(-v);
+  }
+  std::uniform_int_distribution<int> near(-14, 29);
+  std::uniform_int_distribution<long> digits(100000000L, 9999999999L);
+  for (int i = 0; i < 200000; ++i) {
+    const double d = static_cast<double>(digits(rng));
+    const int e = near(rng);
+    double v = d * std::pow(10.0, e - 9);
+    if (i % 3 == 0) v = (std::floor(d / 10) + 0.5) * std::pow(10.0, e - 8);
+    values.push_back(i % 2 ? -v : v);
   }
   int mismatches = 0;
   std::string row;
