@@ -3,6 +3,7 @@
 #ifndef VMHAPTICS_REPORT_SVG_TEXT_H_
 #define VMHAPTICS_REPORT_SVG_TEXT_H_
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -18,9 +19,14 @@ inline std::string format(const char* f, double v) {
 
 // a pixel coordinate: two decimals, far below what a screen shows; a
 // non-finite value is drawn at 0 rather than breaking the document
+// (std::to_chars gives printf's "%.2f" text, C++17 [utility.to.chars], at
+// a fraction of snprintf's cost: the figures have thousands of points)
 inline std::string px(double v) {
   if (!std::isfinite(v)) v = 0.0;
-  std::string s = format("%.2f", v);
+  char buf[352];  // "%.2f" of the largest double: 309 digits and 3 more
+  const std::to_chars_result r = std::to_chars(
+      buf, buf + sizeof buf, v, std::chars_format::fixed, 2);
+  std::string s(buf, r.ptr);
   if (s == "-0.00") s = "0.00";
   return s;
 }

@@ -7,14 +7,17 @@
 //
 // With VMH_SVG_CHART_DIR set, the charts are also written there for a look.
 #include "report/svg_chart.h"
+#include "report/svg_text.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <random>
 #include <regex>
 #include <sstream>
 #include <stdexcept>
@@ -481,6 +484,37 @@ TEST(SvgChartTest, GridOfPanels) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("panel 1"), std::string::npos) << e.what();
   }
+}
+
+// A pixel coordinate is printf's "%.2f" (std::to_chars writes it), with
+// -0.00 written 0.00 and a non-finite value drawn at 0: checked against
+// snprintf over the magnitudes a figure has, ties of the second decimal,
+// and the extremes.
+TEST(SvgText, PixelCoordinatesArePrintfsTwoDecimals) {
+  std::vector<double> values = {0.0, -0.0, 0.005, -0.005, 0.015, 2.675, 1.005,
+                                -0.004, 1e15, -1e300,
+                                std::numeric_limits<double>::max(),
+                                -std::numeric_limits<double>::max(),
+                                std::numeric_limits<double>::denorm_min()};
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> coord(-5000.0, 5000.0);
+  for (int i = 0; i < 100000; ++i) {
+    const double v = coord(rng);
+    values.push_back(i % 4 ? v : std::round(v * 200.0) / 200.0);  // ties
+  }
+  int mismatches = 0;
+  for (double v : values) {
+    char want[400];
+    std::snprintf(want, sizeof want, "%.2f", v);
+    std::string w = want;
+    if (w == "-0.00") w = "0.00";
+    if (svg::px(v) != w && ++mismatches <= 5) {
+      ADD_FAILURE() << "px wrote " << svg::px(v) << ", printf writes " << w;
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(svg::px(std::nan("")), "0.00");
+  EXPECT_EQ(svg::px(-std::numeric_limits<double>::infinity()), "0.00");
 }
 
 }  // namespace
