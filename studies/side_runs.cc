@@ -1,7 +1,10 @@
 #include "studies/side_runs.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <set>
 #include <string>
@@ -30,6 +33,24 @@ SidePlan plan_side(const HandScript& script, const std::vector<Claim>& claims,
     if (plan.read[k]) plan.last_read = static_cast<int>(k);
   }
   return plan;
+}
+
+void reserve_rows(std::vector<TickRecord>* rows, std::size_t n) {
+  rows->clear();
+  if (rows->capacity() >= n) return;
+  rows->shrink_to_fit();  // one block at a time
+  rows->reserve(n);
+#ifdef MADV_HUGEPAGE
+  // the whole 2 MB pages inside the block; madvise's failure changes nothing
+  constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
+  const auto begin = reinterpret_cast<std::uintptr_t>(rows->data());
+  const std::uintptr_t end = begin + rows->capacity() * sizeof(TickRecord);
+  const std::uintptr_t first = (begin + kHuge - 1) & ~(kHuge - 1);
+  const std::uintptr_t last = end & ~(kHuge - 1);
+  if (last > first) {
+    madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+  }
+#endif
 }
 
 void use_reference_gains(ClosedLoop* loop) {
@@ -78,8 +99,7 @@ void run_side(ClosedLoop* loop, const SidePlan& plan, SideMode mode,
     read_s += s.t1_s - read_from_s(s);
   }
   std::vector<TickRecord>& rows = *rows_out;
-  rows.clear();
-  rows.reserve(static_cast<std::size_t>(read_s / T) + 16);
+  reserve_rows(&rows, static_cast<std::size_t>(read_s / T) + 16);
   TickRecord row;
   SideStats st;
   int segment = -1;
