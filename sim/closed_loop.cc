@@ -62,7 +62,7 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
                        const ModelHook& model_hook)
     : path_(scene_path),
       model_(load_scene_model(scene_path, model_hook)),
-      config_(CaseConfig::from_model(model_.get(), scene_path, overrides)) {
+      case_(make_case(scene_path, *model_, overrides)) {
   init();
 }
 
@@ -70,17 +70,16 @@ ClosedLoop::ClosedLoop(const std::string& scene_path, const mjModel& compiled,
                        const std::vector<std::string>& overrides)
     : path_(scene_path),
       model_(copy_model(compiled, scene_path)),
-      config_(CaseConfig::from_model(model_.get(), scene_path, overrides)) {
+      case_(make_case(scene_path, *model_, overrides)) {
   init();
 }
 
 void ClosedLoop::init() {
   apply_model_options();
-  setup_timing();
   data_.reset(mj_makeData(model_.get()));
   if (!data_) throw SimError(path_ + ": mj_makeData failed");
   hand_ = std::make_unique<SimHand>(model_.get(), data_.get(),
-                                    hand_params(config_), path_);
+                                    hand_params(case_.config()), path_);
   {
     // the grip site's offset and rotation in the stylus body, fixed
     const int g = hand_->grip_site();
@@ -92,14 +91,13 @@ void ClosedLoop::init() {
   qpos_before_.assign(static_cast<std::size_t>(model_->nq), 0.0);
   dq_.assign(static_cast<std::size_t>(model_->nv), 0.0);
   mv_.assign(static_cast<std::size_t>(model_->nv), 0.0);
-  script_ = std::make_unique<HandScript>(config_, params_.vm);
   q_start_dh_ = start_pose();
   reset();
 }
 
 void ClosedLoop::apply_model_options() {
   mjModel* m = model_.get();
-  const SimSettings& sim = config_.sim;
+  const SimSettings& sim = case_.config().sim;
   if (sim.physics_step_s > 0.0) m->opt.timestep = sim.physics_step_s;
   switch (sim.integrator) {
     case IntegratorSetting::kScene: break;
@@ -109,85 +107,11 @@ void ClosedLoop::apply_model_options() {
   }
 }
 
-void ClosedLoop::setup_timing() {
-  // every count below is computed in double, checked against its bound and
-  // only then made an integer; the table's ranges (sim/case_fields.cc)
-  // have already refused non-finite values, T outside [1e-5, 1] s and a
-  // duration outside (0, 3600] s
-  const double T = config_.controller.servo_period_s;
-  const double h = model_->opt.timestep;
-  const std::string step_name =
-      config_.sim.physics_step_s > 0.0 ? "physics_step_s"
-                                       : "the scene's <option timestep>";
-  if (!std::isfinite(h) || !(h > 0.0)) {
-    throw SimError(path_ + ": " + step_name + " must be finite and > 0, got " +
-                   num(h) + " s");
-  }
-  const double n = std::round(T / h);
-  if (!(n >= 1.0 && n <= static_cast<double>(kMaxSubstepsPerTick))) {
-    throw SimError(path_ + ": servo_period_s / " + step_name + " (" + num(T) +
-                   " s / " + num(h) + " s) must be a whole number of physics "
-                   "steps in [1, " + std::to_string(kMaxSubstepsPerTick) +
-                   "], got " + num(T / h));
-  }
-  if (std::abs(n * h - T) > 1e-9 * T) {
-    throw SimError(path_ + ": servo_period_s (" + num(T) +
-                   " s) must be a whole multiple of the physics step (" +
-                   num(h) + " s)");
-  }
-  substeps_ = static_cast<int>(n);
-  duration_s_ = config_.sim.duration_s;
-  const double ticks = std::round(duration_s_ / T);
-  if (!(ticks >= 1.0 && ticks <= static_cast<double>(kMaxTicksPerRun))) {
-    throw SimError(path_ + ": duration_s (" + num(duration_s_) +
-                   " s) must last from 1 to " +
-                   std::to_string(kMaxTicksPerRun) +
-                   " servo periods (servo_period_s = " + num(T) +
-                   " s), got " + num(duration_s_ / T));
-  }
-  ticks_per_run_ = static_cast<std::int64_t>(ticks);
-  jitter_seed_ = config_.sim.jitter_seed;
-  setup_jitter(h);
-}
-
-void ClosedLoop::setup_jitter(double h) {
-  jitter_lo_ = jitter_hi_ = substeps_;
-  const double jitter_s[2] = {config_.sim.jitter_min_s,
-                              config_.sim.jitter_max_s};
-  if (!(jitter_s[1] > 0.0)) return;
-  jitter_ = true;
-  const double steps[2] = {std::round(jitter_s[0] / h),
-                           std::round(jitter_s[1] / h)};
-  if (steps[0] < 1.0) {
-    throw SimError(path_ + ": servo_jitter_s's shortest period (" +
-                   num(jitter_s[0]) + " s) is less than one physics step (" +
-                   num(h) + " s)");
-  }
-  if (!(steps[1] <= static_cast<double>(kMaxSubstepsPerTick))) {
-    throw SimError(path_ + ": servo_jitter_s's longest period / the physics "
-                   "step (" + num(jitter_s[1]) + " s / " + num(h) +
-                   " s) must be at most " +
-                   std::to_string(kMaxSubstepsPerTick) +
-                   " physics steps, got " + num(jitter_s[1] / h));
-  }
-  // the periods are drawn in whole physics steps: ends that are not whole
-  // steps would be moved without a word
-  for (double end_s : jitter_s) {
-    if (std::abs(std::round(end_s / h) * h - end_s) > 1e-9 * end_s) {
-      throw SimError(path_ + ": servo_jitter_s (" + num(end_s) +
-                     " s) must be a whole multiple of the physics step (" +
-                     num(h) + " s); set physics_step_s");
-    }
-  }
-  jitter_lo_ = static_cast<int>(steps[0]);
-  jitter_hi_ = static_cast<int>(steps[1]);
-}
-
 void ClosedLoop::build_controller() {
   mjModel* m = model_.get();
-  // the case's controller, the gimbal's ranges opened without its limits
-  params_ = case_controller_params(config_);
-  if (!config_.sim.gimbal_limits) {
+  const ControllerParams& params = case_.controller_params();
+  // the case's controller has the gimbal's ranges opened without its limits
+  if (!case_.config().sim.gimbal_limits) {
     // the wrist free to turn through its singularity: no limits on q4..q6
     // in the model either
     for (int i = 3; i < 6; ++i) {
@@ -202,7 +126,7 @@ void ClosedLoop::build_controller() {
     const std::string name = "m" + std::to_string(i + 1);
     const int a = mj_name2id(m, mjOBJ_ACTUATOR, name.c_str());
     if (a < 0 || !m->actuator_ctrllimited[a]) continue;
-    const double lim = params_.omni.motor_torque_limit_Nm[static_cast<std::size_t>(i)];
+    const double lim = params.omni.motor_torque_limit_Nm[static_cast<std::size_t>(i)];
     m->actuator_ctrlrange[2 * a] = -lim;
     m->actuator_ctrlrange[2 * a + 1] = lim;
     if (m->actuator_forcelimited[a]) {
@@ -210,32 +134,27 @@ void ClosedLoop::build_controller() {
       m->actuator_forcerange[2 * a + 1] = lim;
     }
   }
-  try {
-    params_.validate();
-  } catch (const std::invalid_argument& e) {
-    throw SimError(path_ + ": " + e.what());
-  }
 }
 
 void ClosedLoop::build_device_chain() {
-  const SimSettings& sim = config_.sim;
+  const SimSettings& sim = case_.config().sim;
   device_ = std::make_unique<SimDevice>(model_.get(), data_.get(),
-                                        params_.omni, sim.quantize,
+                                        case_.controller_params().omni, sim.quantize,
                                         sim.delay_ticks, path_);
   FaultSpec fault;
   fault.kind = sim.fault;
   fault.joint = sim.fault_joint - 1;
   fault.at_s = sim.fault_at_s;
-  fault.jump_rad = kJumpCounts * 2.0 * kPi / params_.omni.encoder_counts_per_rev;
+  fault.jump_rad = kJumpCounts * 2.0 * kPi / case_.controller_params().omni.encoder_counts_per_rev;
   injector_ = std::make_unique<FaultInjector>(device_.get(), fault);
   ChainOptions chain;
   chain.mode = ChainMode::kRun;
   chain.guard.enabled = sim.sensor_guard;
   chain.guard.max_speed_rad_s = sim.guard_max_speed_rad_s;
-  chain.guard.max_period_s = jitter_hi_ * model_->opt.timestep;
-  chain.controller = params_;
+  chain.guard.max_period_s = case_.substeps_max() * model_->opt.timestep;
+  chain.controller = case_.controller_params();
   chain.safety = sim.safety_layer;
-  chain.safety_params = safety_params_for(params_);
+  chain.safety_params = safety_params_for(case_.controller_params());
   try {
     chain_ = std::make_unique<ServoChain>(injector_.get(), chain);
   } catch (const std::invalid_argument& e) {
@@ -246,8 +165,8 @@ void ClosedLoop::build_device_chain() {
 Joints ClosedLoop::start_pose() {
   // the script's first target, the stylus turned the least from its home
   // frame; the IK solution nearest the home pose
-  const OmniParams& omni = params_.omni;
-  const ScriptPose start = script_->at(0.0);
+  const OmniParams& omni = case_.controller_params().omni;
+  const ScriptPose start = case_.script().at(0.0);
   const Mat3 R_home = omni_fk(omni, Joints::Zero()).R_base;
   R_start_base_ = turn_to_axis(R_home, device_to_base_vector(start.axis));
   const Vec3 p_base = device_mm_to_base(omni, start.p_mm);
@@ -279,20 +198,20 @@ void ClosedLoop::set_reference(const ControllerParams& params) {
 }
 
 double ClosedLoop::time_s() const {
-  if (jitter_) return static_cast<double>(substep_count_) * model_->opt.timestep;
-  return static_cast<double>(tick_count_) * params_.servo_period_s;
+  if (case_.jitter()) return static_cast<double>(substep_count_) * model_->opt.timestep;
+  return static_cast<double>(tick_count_) * case_.controller_params().servo_period_s;
 }
 
 bool ClosedLoop::finished() const {
-  return script_time_s() >= duration_s_ - 0.5 * model_->opt.timestep;
+  return script_time_s() >= case_.config().sim.duration_s - 0.5 * model_->opt.timestep;
 }
 
 void ClosedLoop::skip_script_to(double t_s) {
   const double now_s = script_time_s();
-  if (!(t_s >= now_s && t_s <= duration_s_)) {
+  if (!(t_s >= now_s && t_s <= case_.config().sim.duration_s)) {
     throw std::invalid_argument(
         path_ + ": the script's clock can move forward only, within its " +
-        num(duration_s_) + " s: asked " + num(t_s) + " s at " + num(now_s) +
+        num(case_.config().sim.duration_s) + " s: asked " + num(t_s) + " s at " + num(now_s) +
         " s");
   }
   script_skipped_s_ += t_s - now_s;
@@ -311,9 +230,11 @@ void ClosedLoop::throw_if_physics_fault() const {
 }
 
 int ClosedLoop::draw_substeps() {
-  if (!jitter_) return substeps_;
-  const auto span = static_cast<std::uint64_t>(jitter_hi_ - jitter_lo_ + 1);
-  return jitter_lo_ + static_cast<int>(next_random(&rng_state_) % span);
+  if (!case_.jitter()) return case_.substeps();
+  const auto span = static_cast<std::uint64_t>(case_.substeps_max() -
+                                               case_.substeps_min() + 1);
+  return case_.substeps_min() +
+         static_cast<int>(next_random(&rng_state_) % span);
 }
 
 void ClosedLoop::reset() {
@@ -326,7 +247,7 @@ void ClosedLoop::reset() {
   tick_count_ = 0;
   substep_count_ = 0;
   script_skipped_s_ = 0.0;
-  rng_state_ = jitter_seed_;
+  rng_state_ = case_.config().sim.jitter_seed;
   energy_motor_J_ = 0.0;
   energy_hand_J_ = 0.0;
   // mj_resetData cleared mjData::warning[]
@@ -361,7 +282,7 @@ ScriptPose ClosedLoop::wrist_pose_of(const HandTargetState& grip) const {
   // undo set_hand_target's grip = wrist + R grip_local, R_grip = R R_site
   const Mat3 R = grip.R * R_site_.transpose();
   ScriptPose pose;
-  pose.p_mm = base_to_device_mm(params_.omni, grip.p_m - R * grip_local_);
+  pose.p_mm = base_to_device_mm(case_.controller_params().omni, grip.p_m - R * grip_local_);
   pose.axis = base_to_device_vector(R.col(2));
   return pose;
 }
@@ -387,9 +308,9 @@ const Mat3& ClosedLoop::stylus_turned_to(const Vec3& axis_base) {
 }
 
 ScriptPose ClosedLoop::script_target(double t_s) {
-  const OmniParams& omni = params_.omni;
+  const OmniParams& omni = case_.controller_params().omni;
   auto target_at = [&](double t, Vec3* p_grip, Mat3* R_grip) {
-    const ScriptPose pose = script_->at(t);
+    const ScriptPose pose = case_.script().at(t);
     const Mat3& R = stylus_turned_to(device_to_base_vector(pose.axis));
     // the stylus body's origin is the wrist centre
     const Vec3 wrist = device_mm_to_base(omni, pose.p_mm);
@@ -399,7 +320,7 @@ ScriptPose ClosedLoop::script_target(double t_s) {
   };
   HandTargetState target;
   // past the script's end the hand holds its last target still
-  const double t_end_s = duration_s_;
+  const double t_end_s = case_.config().sim.duration_s;
   const ScriptPose pose =
       target_at(std::min(t_s, t_end_s), &target.p_m, &target.R);
   // the target's velocity by a forward difference over a small interval
@@ -416,12 +337,12 @@ ScriptPose ClosedLoop::script_target(double t_s) {
 
 // the mechanism works in the controller's length unit
 double ClosedLoop::distance_to_path_mm(const Vec3& p_mm) const {
-  const double u = params_.length_unit_mm;
+  const double u = case_.controller_params().length_unit_mm;
   return controller().mechanism().distance_to_path(p_mm / u) * u;
 }
 
 Vec3 ClosedLoop::nearest_on_path_mm(const Vec3& p_mm) const {
-  const double u = params_.length_unit_mm;
+  const double u = case_.controller_params().length_unit_mm;
   return controller().mechanism().nearest_on_path(p_mm / u) * u;
 }
 
@@ -429,8 +350,8 @@ void ClosedLoop::tick(TickRecord* row) {
   // the script's clock (the physics' own, unless a run skipped ahead)
   const double t = script_time_s();
   const double t_physics = time_s();
-  const double t_script = std::min(t, duration_s_);
-  row->segment = script_->segment_at(t_script);
+  const double t_script = std::min(t, case_.config().sim.duration_s);
+  row->segment = case_.script().segment_at(t_script);
   if (manual_hand_) {
     hand_->set_target(model_.get(), data_.get(), manual_target_);
     row->hand_target = wrist_pose_of(manual_target_);
@@ -447,7 +368,7 @@ void ClosedLoop::tick(TickRecord* row) {
   row->q_dh = device_to_dh_joints(injector_->last_reading());
   row->fault_injected = injector_->active();
   row->motor_torque_Nm = device_->motor_torque_Nm();
-  const OmniParams& omni = params_.omni;
+  const OmniParams& omni = case_.controller_params().omni;
   row->q_true_dh = device_->true_q_dh();
   OmniPose pose_true;
   omni_fk_jacobian(omni, row->q_true_dh, &pose_true, nullptr);

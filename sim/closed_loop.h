@@ -46,6 +46,7 @@
 #include "device/reading_guard.h"
 #include "device/servo_chain.h"
 #include "device/tick_record.h"
+#include "sim/case.h"
 #include "sim/case_config.h"
 #include "sim/fault_injector.h"
 #include "sim/omni_model_edit.h"
@@ -150,21 +151,26 @@ class ClosedLoop {
   void skip_script_to(double t_s);
   // the run's length in ticks at the nominal period; with servo jitter the
   // count differs, so loop until finished()
-  std::int64_t ticks_per_run() const { return ticks_per_run_; }
+  std::int64_t ticks_per_run() const { return case_.ticks_per_run(); }
   // whether script_time_s() has reached duration_s
   bool finished() const;
   // physics steps per tick at the nominal period
-  int substeps() const { return substeps_; }
+  int substeps() const { return case_.substeps(); }
   // the range of physics steps per tick (both substeps() without jitter)
-  int substeps_min() const { return jitter_lo_; }
-  int substeps_max() const { return jitter_hi_; }
-  bool jitter() const { return jitter_; }
+  int substeps_min() const { return case_.substeps_min(); }
+  int substeps_max() const { return case_.substeps_max(); }
+  bool jitter() const { return case_.jitter(); }
   // the passivity observer's totals so far, J (see the file comment)
   double energy_motor_J() const { return energy_motor_J_; }
   double energy_hand_J() const { return energy_hand_J_; }
-  const CaseConfig& config() const { return config_; }
-  const ControllerParams& controller_params() const { return params_; }
-  const HandScript& script() const { return *script_; }
+  // the case this loop runs (sim/case.h): parameters, controller, script
+  // and timing, read once from the scene
+  const Case& the_case() const { return case_; }
+  const CaseConfig& config() const { return case_.config(); }
+  const ControllerParams& controller_params() const {
+    return case_.controller_params();
+  }
+  const HandScript& script() const { return case_.script(); }
   const Controller& controller() const { return *chain_->controller(); }
   const mjModel* model() const { return model_.get(); }
   mjData* data() { return data_.get(); }
@@ -202,16 +208,14 @@ class ClosedLoop {
   Vec3 nearest_on_path_mm(const Vec3& p_mm) const;
 
  private:
-  // construction, in order: the scene's <option>s (physics step,
-  // integrator); the servo period in physics steps, the run's length and
-  // the jitter; the controller's parameters (and the gimbal limits); the
+  // construction, in order, once the case is read (make_case: parameters,
+  // controller, script, timing): the case's physics step and integrator
+  // put in the model; the gimbal limits and motor ranges it asks for; the
   // device chain SimDevice <- FaultInjector <- ServoChain (guard, safety,
-  // controller); the start pose (sets
-  // R_start_base_, returns the joint angles)
-  void init();  // both constructors' work once model_ and config_ are set
+  // controller); the start pose (sets R_start_base_, returns the joint
+  // angles)
+  void init();  // both constructors' work once model_ and case_ are set
   void apply_model_options();
-  void setup_timing();
-  void setup_jitter(double h);
   void build_controller();
   void build_device_chain();
   Joints start_pose();
@@ -233,13 +237,11 @@ class ClosedLoop {
   std::string path_;
   ModelPtr model_;
   DataPtr data_;
-  CaseConfig config_;
-  ControllerParams params_;
+  Case case_;
   std::unique_ptr<SimHand> hand_;
   std::unique_ptr<SimDevice> device_;
   std::unique_ptr<FaultInjector> injector_;
   std::unique_ptr<ServoChain> chain_;
-  std::unique_ptr<HandScript> script_;
   Joints q_start_dh_ = Joints::Zero();
   Mat3 R_start_base_ = Mat3::Identity();  // stylus frame at the start pose
   // the grip site in the stylus body: offset (m) and rotation
@@ -253,15 +255,10 @@ class ClosedLoop {
   };
   std::array<TurnMemo, 2> turn_memo_{};
   int turn_memo_next_ = 0;
-  int substeps_ = 1;
-  std::int64_t ticks_per_run_ = 0;
-  double duration_s_ = 0.0;  // the script's, read once (the tick reads it)
   std::int64_t tick_count_ = 0;
   double script_skipped_s_ = 0.0;  // skip_script_to()'s total
-  // servo jitter: steps per tick drawn from [lo, hi]; the generator's state
-  bool jitter_ = false;
-  int jitter_lo_ = 1, jitter_hi_ = 1;
-  std::uint64_t jitter_seed_ = 1;
+  // servo jitter: the generator's state (steps per tick drawn from the
+  // case's [substeps_min, substeps_max])
   std::uint64_t rng_state_ = 1;
   std::int64_t substep_count_ = 0;  // physics steps since t = 0
   bool manual_hand_ = false;

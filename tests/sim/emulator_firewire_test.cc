@@ -37,7 +37,7 @@ using fw::TransportStatus;
 using vmh::testing::wait_for;
 
 // in lockstep
-EmulatorFirewireOptions options(HandProgram p) {
+EmulatorFirewireOptions fw_options(HandProgram p) {
   EmulatorFirewireOptions o;
   o.emulator.lockstep = true;
   o.emulator.scene = std::string(VMH_MODELS_DIR) + "/cases/case1.xml";
@@ -46,8 +46,8 @@ EmulatorFirewireOptions options(HandProgram p) {
 }
 
 // the physics thread on the wall clock (EmulatorFirewireRealtime only)
-EmulatorFirewireOptions wall_options(HandProgram p) {
-  EmulatorFirewireOptions o = options(p);
+EmulatorFirewireOptions fw_wall_options(HandProgram p) {
+  EmulatorFirewireOptions o = fw_options(p);
   o.emulator.lockstep = false;
   return o;
 }
@@ -140,7 +140,7 @@ TEST(WireFaults, BadItemsAreNamed) {
 }
 
 TEST(EmulatorFirewire, NodeIsTheEmulatorsSerialOnSensablesVendor) {
-  EmulatorFirewireOptions o = options(HandProgram::kTour);
+  EmulatorFirewireOptions o = fw_options(HandProgram::kTour);
   o.emulator.serial = "EMU-0042";
   EmulatorFirewireTransport t(o);
   const fw::NodeInfo n = t.node();
@@ -158,7 +158,7 @@ TEST(EmulatorFirewire, NodeIsTheEmulatorsSerialOnSensablesVendor) {
 }
 
 TEST(EmulatorFirewire, BadFactoryOptionsAreNamed) {
-  EmulatorFirewireOptions o = options(HandProgram::kTour);
+  EmulatorFirewireOptions o = fw_options(HandProgram::kTour);
   o.factory_full_scale_Nm[1] = 0.0;
   EXPECT_THROW(
       {
@@ -171,7 +171,7 @@ TEST(EmulatorFirewire, BadFactoryOptionsAreNamed) {
         }
       },
       std::invalid_argument);
-  o = options(HandProgram::kTour);
+  o = fw_options(HandProgram::kTour);
   o.factory_motor_sign[2] = 0;
   EXPECT_THROW(EmulatorFirewireTransport t(o), std::invalid_argument);
 }
@@ -182,7 +182,7 @@ TEST(EmulatorFirewire, BadFactoryOptionsAreNamed) {
 // packet and the emulator's reading of the same period are taken together,
 // so every packet is matched (the old test matched some 100 of 300).
 TEST(EmulatorFirewire, PacketsCarryTheEmulatorsRawReadings) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   Emulator* emu = t.emulator();
   t.start();
   emu->press_buttons(kButton2);
@@ -219,7 +219,7 @@ TEST(EmulatorFirewire, PacketsCarryTheEmulatorsRawReadings) {
 // Through the wire and FirewireOmni the angles are the emulator's own (its
 // factory calibration) to rounding, over a tour that moves every joint.
 TEST(EmulatorFirewire, AnglesThroughTheWireEqualTheEmulators) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   Emulator* emu = t.emulator();
   fw::FirewireOmni omni(&t, omni_options(t));
   t.start();
@@ -254,7 +254,7 @@ TEST(EmulatorFirewire, AnglesThroughTheWireEqualTheEmulators) {
 // the next period (the old test polled for up to 2 s) with its sign and
 // value, within one 12-bit motor word; motors off is zero.
 TEST(EmulatorFirewire, TorqueThroughTheWireReachesTheMotors) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   Emulator* emu = t.emulator();
   fw::FirewireOmni omni(&t, omni_options(t));
   t.start();
@@ -281,7 +281,7 @@ TEST(EmulatorFirewire, TorqueThroughTheWireReachesTheMotors) {
 // believes: motor 2 turns the other way, motor 1 is 20 % weaker than the
 // estimate.
 TEST(EmulatorFirewire, TheFactoryScaleAndSignAreTheDevicesOwn) {
-  EmulatorFirewireOptions o = options(HandProgram::kTour);
+  EmulatorFirewireOptions o = fw_options(HandProgram::kTour);
   const double est = fw::kMotorFullScaleEstimate_Nm;  // what the host assumes
   o.factory_full_scale_Nm = {0.8 * est, est, est};
   o.factory_motor_sign = {+1, -1, +1};
@@ -299,7 +299,7 @@ TEST(EmulatorFirewire, TheFactoryScaleAndSignAreTheDevicesOwn) {
 }
 
 TEST(EmulatorFirewire, LossTimesOutTheNextPacketsAndTheCounterShowsTheGap) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   fw::FirewireOmni omni(&t, omni_options(t));
   t.start();
   DeviceState s;
@@ -321,7 +321,7 @@ TEST(EmulatorFirewire, LossTimesOutTheNextPacketsAndTheCounterShowsTheGap) {
 }
 
 TEST(EmulatorFirewire, WrongLengthsAreBadPacketsThenDataAgain) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   t.start();
   std::uint8_t buf[64];
   std::size_t size = 0;
@@ -353,7 +353,7 @@ TEST(EmulatorFirewire, WrongLengthsAreBadPacketsThenDataAgain) {
 }
 
 TEST(EmulatorFirewire, BusResetUntilRecoverWithTheMotorsAtZero) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   Emulator* emu = t.emulator();
   fw::FirewireOmni omni(&t, omni_options(t));
   t.start();
@@ -407,7 +407,7 @@ TEST(EmulatorFirewire, BusResetUntilRecoverWithTheMotorsAtZero) {
 // Unplugged: kNotConnected and zero torque for the duration, however hard
 // the host keeps writing; then back, readings and torque again.
 TEST(EmulatorFirewire, UnplugIsDisconnectedWithZeroTorqueThenBack) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   Emulator* emu = t.emulator();
   fw::FirewireOmni omni(&t, omni_options(t));
   t.start();
@@ -448,7 +448,7 @@ TEST(EmulatorFirewire, UnplugIsDisconnectedWithZeroTorqueThenBack) {
 
 // Late: every packet K periods old (its time field says so), then fresh.
 TEST(EmulatorFirewire, LatePacketsAreOldThenFreshAgain) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   Emulator* emu = t.emulator();
   t.start();
   std::uint8_t buf[64];
@@ -483,7 +483,7 @@ TEST(EmulatorFirewire, LatePacketsAreOldThenFreshAgain) {
 // start(), rounded: k T for k = 1025 is 1.0249999999999999 s as a double, and
 // a truncating conversion would write 1024999.
 TEST(EmulatorFirewire, TheTimeFieldIsRoundedNotTruncated) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   Emulator* emu = t.emulator();
   t.start();
   std::uint8_t buf[64];
@@ -503,7 +503,7 @@ TEST(EmulatorFirewire, TheTimeFieldIsRoundedNotTruncated) {
 
 // A stall: no packets at all (time-outs), and none counted as lost.
 TEST(EmulatorFirewire, StallSendsNothing) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   Emulator* emu = t.emulator();
   fw::FirewireOmni omni(&t, omni_options(t));
   t.start();
@@ -535,7 +535,7 @@ TEST(EmulatorFirewire, StallSendsNothing) {
 }
 
 TEST(EmulatorFirewire, ReceiveAndSendAllocateNothing) {
-  EmulatorFirewireTransport t(options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_options(HandProgram::kTour));
   fw::FirewireOmni omni(&t, omni_options(t));
   t.start();
   DeviceState s;
@@ -580,7 +580,7 @@ TEST(EmulatorFirewire, ReceiveAndSendAllocateNothing) {
 // the counter +1 a packet, the time never going back; after stop() the
 // device is gone.
 TEST(EmulatorFirewireRealtime, PacketsStreamFromThePhysicsThread) {
-  EmulatorFirewireTransport t(wall_options(HandProgram::kTour));
+  EmulatorFirewireTransport t(fw_wall_options(HandProgram::kTour));
   t.start();
   std::uint8_t buf[64];
   std::size_t size = 0;
@@ -616,7 +616,7 @@ TEST(EmulatorFirewireRealtime, PacketsStreamFromThePhysicsThread) {
 // emulator_test.cc's StarvedPhysicsIsNamedNotUnplugged) shows on the wire
 // as time-outs, never as a vanished device, and stall_cause() names it.
 TEST(EmulatorFirewireRealtime, StarvedPhysicsIsATimeoutNotADisconnect) {
-  EmulatorFirewireOptions o = wall_options(HandProgram::kTour);
+  EmulatorFirewireOptions o = fw_wall_options(HandProgram::kTour);
   o.emulator.realtime_factor = 1e4;
   o.emulator.realtime_priority = 0;  // it never sleeps: keep it off SCHED_FIFO
   EmulatorFirewireTransport t(o);
