@@ -32,7 +32,7 @@
 #include "studies/run_case.h"
 #include "studies/stability_study.h"
 #ifdef VMH_HAVE_VIZ
-#include "sim/closed_loop.h"
+#include "sim/case.h"
 #include "viz/render.h"
 #endif
 
@@ -56,10 +56,10 @@ studies::RenderFn case_renderer(const fs::path& dir) {
     try {
       double t_s = 0.0;
       {
-        const sim::ClosedLoop loop(scene_path, {});
-        const auto& segs = loop.script().segments();
-        t_s = 0.5 * static_cast<double>(loop.ticks_per_run()) *
-              loop.controller_params().servo_period_s;
+        const sim::Case c = sim::load_case(scene_path, {});
+        const auto& segs = c.script().segments();
+        t_s = 0.5 * static_cast<double>(c.ticks_per_run()) *
+              c.controller_params().servo_period_s;
         for (const sim::ScriptSegment& g : segs) {
           if (g.name == "off_out_misaligned") {
             t_s = 0.5 * (g.settled_from_s() + g.t1_s);

@@ -21,7 +21,7 @@
 #include "cli/study.h"
 #include "cli/study_files.h"
 #include "report/progress.h"
-#include "sim/closed_loop.h"
+#include "sim/case.h"
 #include "sim/mujoco_util.h"
 #include "studies/precision_study.h"
 
@@ -112,7 +112,7 @@ studies::PrecisionOptions to_options(const PrecisionCli& o) {
 void check_against_case(const studies::PrecisionOptions& p) {
   double period_s = 0.0, script_s = 0.0;
   try {
-    sim::ClosedLoop probe(p.scene, p.overrides);
+    const sim::Case probe = sim::load_case(p.scene, p.overrides);
     period_s = probe.controller_params().servo_period_s;
     script_s = probe.config().sim.duration_s;
   } catch (const sim::SimError& e) {

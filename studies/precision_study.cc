@@ -13,6 +13,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "sim/case.h"
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
 
@@ -304,12 +305,14 @@ struct Setting {
 // segments, read from a loop built once, and the duration checked against
 // the case's script.
 void probe_scene(const PrecisionOptions& o, PrecisionResult* r) {
-  ClosedLoop probe(o.scene, o.overrides);
+  const sim::Case probe = sim::load_case(o.scene, o.overrides);
   r->servo_period_s = probe.controller_params().servo_period_s;
-  r->default_step_s = probe.model()->opt.timestep;
-  switch (probe.model()->opt.integrator) {
-    case mjINT_RK4: r->default_integrator = Integrator::kRk4; break;
-    case mjINT_IMPLICIT: r->default_integrator = Integrator::kImplicit; break;
+  r->default_step_s = probe.physics_step_s();
+  switch (probe.integrator()) {
+    case sim::IntegratorSetting::kRk4: r->default_integrator = Integrator::kRk4; break;
+    case sim::IntegratorSetting::kImplicit:
+      r->default_integrator = Integrator::kImplicit;
+      break;
     default: r->default_integrator = Integrator::kEuler; break;
   }
   for (const ScriptSegment& seg : probe.script().segments()) {

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "report/parallel.h"
+#include "sim/case.h"
 #include "sim/case_params.h"
 #include "sim/closed_loop.h"
 #include "sim/omni_model_edit.h"
@@ -323,8 +324,8 @@ SweepPlan plan_sweep(const SensitivityOptions& options) {
   for (const std::string& name : options.cases) {
     SweepCase c;
     c.scene = sim::resolve_scene(name, &c.name);
-    sim::ClosedLoop probe(c.scene, options.overrides);
-    c.physics_step_s = probe.model()->opt.timestep;
+    const sim::Case probe = sim::load_case(c.scene, options.overrides);
+    c.physics_step_s = probe.physics_step_s();
     for (const SweepParameter& p : plan.parameters) {
       SweepValue v;
       switch (p.kind) {
@@ -376,7 +377,7 @@ SweepPlan plan_sweep(const SensitivityOptions& options) {
   // the vector fields a scale multiplies, item by item, as the case has them
   std::vector<std::vector<std::vector<double>>> scaled_items(plan.cases.size());
   for (std::size_t ci = 0; ci < plan.cases.size(); ++ci) {
-    sim::ClosedLoop probe(plan.cases[ci].scene, options.overrides);
+    const sim::Case probe = sim::load_case(plan.cases[ci].scene, options.overrides);
     for (const SweepParameter& p : plan.parameters) {
       scaled_items[ci].push_back(
           p.kind == SweepKind::kFieldScale

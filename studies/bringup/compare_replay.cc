@@ -8,6 +8,7 @@
 #include "controller/controller.h"
 #include "report/output_file.h"
 #include "report/svg_chart.h"
+#include "sim/case.h"
 #include "sim/closed_loop.h"
 
 namespace vmh::bringup {
@@ -199,7 +200,7 @@ void simulate(const Recording& r, const std::string& scene,
   overrides.push_back("duration_s=" + replay_fmt(std::max(duration_s, 1e-3), 9));
   // the gains as hw run scaled them, in the scene's own parameters
   {
-    const sim::ClosedLoop probe(scene, overrides);
+    const sim::Case probe = sim::load_case(scene, overrides);
     const sim::ControllerSettings& cs = probe.config().controller;
     overrides.push_back("k_pos_N_per_mm=" +
                         replay_fmt(gain_scale * cs.k_pos_N_per_mm, 17));

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "controller/device_frame.h"
+#include "sim/case.h"
 #include "sim/closed_loop.h"
 #include "sim/emulator_hand.h"
 #include "sim/mujoco_util.h"
@@ -14,8 +15,9 @@ namespace vmh::bringup {
 ResponseSimulator::ResponseSimulator(const std::string& scene,
                                      const std::string& model_file)
     : scene_(scene), model_file_(model_file) {
-  const sim::ClosedLoop loop(scene, {}, sim::omni_model_hook(model_file));
-  servo_period_s_ = loop.controller_params().servo_period_s;
+  servo_period_s_ = sim::load_case(scene, {}, sim::omni_model_hook(model_file))
+                        .controller_params()
+                        .servo_period_s;
 }
 
 ResponseSimulator::~ResponseSimulator() = default;
