@@ -54,6 +54,19 @@ int write_new_file(const std::string& path, const std::string& text) {
 }  // namespace
 
 void write_file_atomically(const std::string& path, const std::string& text) {
+  // the rename would put a file in place of whatever is at `path`: a
+  // device node, a FIFO, a folder's link are refused, not replaced
+  struct stat st {};
+  if (lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    throw std::runtime_error(
+        path + ": exists and is not a regular file (" +
+        (S_ISLNK(st.st_mode)   ? "a symbolic link"
+         : S_ISDIR(st.st_mode) ? "a folder"
+         : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+         : S_ISFIFO(st.st_mode) ? "a FIFO"
+                                : "not a file") +
+        "); it is not replaced");
+  }
   const std::string tmp = path + ".tmp" + unique_suffix();
   if (const int err = write_new_file(tmp, text)) {
     throw std::runtime_error(path + ": " + os_error(err));

@@ -10,9 +10,12 @@ namespace vmh::report {
 // Writes `text` to `path` through a temporary file beside it, named
 // "<path>.tmp-<pid>-<n>" (unique per process and per call, so two processes
 // writing the same path never share one), and a rename (atomic on one file
-// system): readers see the old file or the whole new one. Throws
-// std::runtime_error naming the path and the OS error when it cannot open,
-// write or rename; the temporary file is removed.
+// system): readers see the old file or the whole new one. Only a regular
+// file is replaced: anything else at `path` (a device node, a FIFO, a
+// folder, a symbolic link) is refused, since the rename would put the file
+// in its place. Throws std::runtime_error naming the path and the OS error
+// (or what is at the path) when it cannot open, write or rename; the
+// temporary file is removed.
 void write_file_atomically(const std::string& path, const std::string& text);
 
 // Creates `dir` if needed and writes dir/name as write_file_atomically does.

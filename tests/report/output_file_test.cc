@@ -3,6 +3,7 @@
 #include "report/output_file.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -56,6 +57,40 @@ TEST(WriteFileAtomically, NamesThePathAndTheOsReason) {
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()),
               (d / "no" / "a.txt").string() + ": No such file or directory");
+  }
+}
+
+// Only a regular file is replaced: a rename over a FIFO, a folder, a
+// symbolic link or a device node would put the file in its place.
+TEST(WriteFileAtomically, ReplacesOnlyARegularFile) {
+  const fs::path d = fresh("not_regular");
+  fs::create_directories(d / "folder");
+  ASSERT_EQ(mkfifo((d / "fifo").c_str(), 0600), 0);
+  std::ofstream(d / "target") << "kept";
+  fs::create_symlink(d / "target", d / "link");
+  for (const char* name : {"fifo", "folder", "link"}) {
+    try {
+      write_file_atomically((d / name).string(), "x");
+      ADD_FAILURE() << name << " replaced";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find((d / name).string() +
+                                           ": exists and is not a regular file"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_TRUE(fs::is_fifo(d / "fifo"));
+  EXPECT_TRUE(fs::is_directory(d / "folder"));
+  EXPECT_TRUE(fs::is_symlink(d / "link"));
+  EXPECT_EQ(slurp(d / "target"), "kept");
+  // nothing else was left: no temporary beside them
+  EXPECT_EQ(names(d), std::set<std::string>({"fifo", "folder", "link", "target"}));
+  // /dev/null is a device: refused by type, never opened for the rename
+  try {
+    write_file_atomically("/dev/null", "x");
+    ADD_FAILURE() << "/dev/null replaced";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("a device"), std::string::npos) << e.what();
   }
 }
 
