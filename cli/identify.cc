@@ -11,7 +11,10 @@
 // converge or is poorly conditioned (the JSON says which, and is still
 // printed and written); 2 bad input (a missing directory, not a
 // recording, no motor pulse in any, an unknown --fit name).
+#include <sys/stat.h>
+
 #include <CLI/CLI.hpp>
+#include <cctype>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -56,12 +59,40 @@ std::vector<std::string> split_names(const std::string& text) {
   return out;
 }
 
-std::string serial_of(const std::vector<bringup::Recording>& recs) {
-  for (const bringup::Recording& r : recs) {
-    const auto& m = r.meta;
+// A serial names the default model file (<models>/omni/calibrated/
+// <serial>.xml), so it must be one file name: 1 to 64 letters, digits,
+// '.', '_' or '-', starting with a letter or digit (no '/', no "..").
+// Throws UsageError naming where it came from otherwise.
+void check_serial(const std::string& serial, const std::string& where) {
+  bool ok = !serial.empty() && serial.size() <= 64 &&
+            std::isalnum(static_cast<unsigned char>(serial[0])) != 0;
+  for (char ch : serial) {
+    const auto u = static_cast<unsigned char>(ch);
+    ok = ok && (std::isalnum(u) != 0 || ch == '.' || ch == '_' || ch == '-');
+  }
+  if (!ok) {
+    std::string shown = serial.substr(0, 80);
+    for (char& ch : shown) {
+      if (!std::isprint(static_cast<unsigned char>(ch))) ch = '?';
+    }
+    throw UsageError("identify: " + where + ": serial '" + shown +
+                     "' is not a device serial (1 to 64 letters, digits, '.', "
+                     "'_' or '-', starting with a letter or digit); it names "
+                     "the calibrated model's file");
+  }
+}
+
+// the device serial of the first recording whose meta.json names one,
+// checked (check_serial); "unknown" if none does
+std::string serial_of(const std::vector<bringup::Recording>& recs,
+                      const std::vector<std::string>& dirs) {
+  for (std::size_t i = 0; i < recs.size(); ++i) {
+    const auto& m = recs[i].meta;
     if (m.contains("device") && m["device"].is_object() &&
         m["device"].contains("serial") && m["device"]["serial"].is_string()) {
-      return m["device"]["serial"].get<std::string>();
+      const std::string s = m["device"]["serial"].get<std::string>();
+      check_serial(s, dirs[i] + "/meta.json's device.serial");
+      return s;
     }
   }
   return "unknown";
@@ -149,6 +180,27 @@ void identify_verb(const IdentifyCliOptions& o) {
       throw UsageError(std::string("identify: not a recording: ") + e.what());
     }
   }
+  // where the results go, checked before the fit and before anything is
+  // written: a bad --out must not leave a model behind
+  if (!o.serial.empty()) check_serial(o.serial, "--serial");
+  const std::string serial = o.serial.empty() ? serial_of(recs, o.dirs) : o.serial;
+  const std::string model = o.model_out.empty()
+                                ? sim::models_dir() + "/omni/calibrated/" + serial + ".xml"
+                                : o.model_out;
+  try {
+    if (!o.out.empty()) report::check_writable_dir(o.out);
+    const std::filesystem::path model_dir =
+        std::filesystem::path(model).parent_path();
+    if (!model_dir.empty()) report::check_writable_dir(model_dir.string());
+    struct stat st {};
+    if (lstat(model.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+      throw std::runtime_error(model + ": exists and is not a regular file; "
+                               "it is not replaced");
+    }
+  } catch (const std::runtime_error& e) {
+    throw UsageError(std::string("identify: ") + e.what());
+  }
+
   bringup::IdentifyResult r;
   try {
     r = bringup::identify(recs, io);
@@ -156,10 +208,6 @@ void identify_verb(const IdentifyCliOptions& o) {
     throw UsageError(e.what());
   }
 
-  const std::string serial = o.serial.empty() ? serial_of(recs) : o.serial;
-  const std::string model = o.model_out.empty()
-                                ? sim::models_dir() + "/omni/calibrated/" + serial + ".xml"
-                                : o.model_out;
   std::ostringstream prov;
   prov << "calibrated by vmhaptics identify: serial " << serial << ", " << utc_now()
        << "; recordings";

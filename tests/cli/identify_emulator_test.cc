@@ -6,9 +6,11 @@
 // friction); the fit must find both within the tolerances docs/bringup.md
 // states, and write a calibrated model that `run --model` accepts.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -60,6 +62,66 @@ TEST(IdentifyEmulator, RecoversSeededMassAndFriction) {
   // the calibrated model drives a run
   const auto run_case = run("run case1 --model " + model.string());
   EXPECT_EQ(run_case.exit_code, 0) << run_case.err;
+}
+
+// Where identify writes is checked before it fits or writes anything
+// (issue 34): a serial that is not one file name (from --serial or from a
+// recording's meta.json) would put the default model path outside
+// models/omni/calibrated; --model-out may replace only a regular file; a
+// bad --out must not leave a model behind. Each is bad input (exit 2),
+// named, and nothing is written.
+TEST(IdentifyEmulator, WritesOnlyWhereItMayAndChecksThatFirst) {
+  const fs::path dir = vmh::testing::fresh_dir("identify_emu_", "paths");
+  const fs::path rec = dir / "motor1";
+  const auto mt = run("hw motor-test --quiet --motor 1 --torque-mNm 150 --ms 60 --out " +
+                      rec.string());
+  ASSERT_EQ(mt.exit_code, 0) << mt.err;
+  const fs::path model = dir / "calibrated.xml";
+  const std::string base = "identify " + rec.string() + " --model-out " + model.string();
+
+  // --serial with a path in it
+  auto r = run(base + " --serial ../../../escape");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--serial"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("../../../escape"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(model));
+
+  // the same from the recording's meta.json
+  nlohmann::json meta;
+  {
+    std::ifstream in(rec / "meta.json");
+    meta = nlohmann::json::parse(in);
+  }
+  meta["device"]["serial"] = "../../trav/pwn";
+  {
+    std::ofstream out(rec / "meta.json");
+    out << meta.dump(2);
+  }
+  r = run(base);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("meta.json"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(model));
+  meta["device"]["serial"] = "OMNI-11254";
+  {
+    std::ofstream out(rec / "meta.json");
+    out << meta.dump(2);
+  }
+
+  // --model-out at a FIFO: refused, the FIFO left as it was
+  const fs::path fifo = dir / "fifo.xml";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  r = run("identify " + rec.string() + " --model-out " + fifo.string());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("not a regular file"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_fifo(fifo));
+
+  // --out is a file: refused before the model is written
+  const fs::path file = dir / "a_file";
+  std::ofstream(file) << "x";
+  r = run(base + " --out " + file.string());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(file.string()), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(model));
 }
 
 TEST(IdentifyEmulator, BadInputIsNamed) {
