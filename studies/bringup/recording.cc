@@ -1,8 +1,13 @@
 #include "studies/bringup/recording.h"
 
+#include <sys/stat.h>
+
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
+#include <set>
 #include <sstream>
 
 namespace vmh::bringup {
@@ -13,6 +18,51 @@ bool is_text_column(const std::string& name) {
          name == "safety_flags" || name == "phase";
 }
 
+// Refuses, by its type and size, a file that is not a regular file (a
+// FIFO would block the reader, a device never end) or is larger than
+// max_bytes, before it is opened.
+void check_regular(const std::string& path, std::int64_t max_bytes) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) return;  // the open names a missing one
+  if (!S_ISREG(st.st_mode)) {
+    throw RecordingError(path + ": not a regular file (" +
+                         (S_ISFIFO(st.st_mode)   ? "a FIFO"
+                          : S_ISDIR(st.st_mode)  ? "a folder"
+                          : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)
+                              ? "a device"
+                              : "not a file") +
+                         "); a recording's files are plain files");
+  }
+  if (st.st_size > max_bytes) {
+    throw RecordingError(path + ": " + std::to_string(st.st_size) +
+                         " bytes, more than a recording's " +
+                         std::to_string(max_bytes));
+  }
+}
+
+// One line of at most kMaxLineBytes into *line, without its '\n' or a
+// '\r' before it (CRLF line ends, RFC 4180's own, as spreadsheet tools on
+// Windows write them). False at the end of the file; throws on a longer
+// line, naming it.
+bool read_line(std::istream& in, std::string* line, const std::string& path,
+               std::size_t line_no) {
+  line->clear();
+  char c = 0;
+  bool any = false;
+  while (in.get(c)) {
+    any = true;
+    if (c == '\n') break;
+    if (line->size() >= kMaxLineBytes) {
+      throw RecordingError(path + ": line " + std::to_string(line_no) +
+                           " is longer than " + std::to_string(kMaxLineBytes) +
+                           " bytes");
+    }
+    line->push_back(c);
+  }
+  if (!line->empty() && line->back() == '\r') line->pop_back();
+  return any;
+}
+
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> out;
   std::string cell;
@@ -20,6 +70,14 @@ std::vector<std::string> split(const std::string& line) {
   while (std::getline(s, cell, ',')) out.push_back(cell);
   if (!line.empty() && line.back() == ',') out.emplace_back();
   return out;
+}
+
+// where t_s is among the columns (the header has it: checked)
+std::ptrdiff_t t_index(const std::vector<std::string>& columns) {
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    if (columns[i] == "t_s") return static_cast<std::ptrdiff_t>(i);
+  }
+  return 0;
 }
 
 }  // namespace
@@ -114,6 +172,7 @@ Recording load_recording(const std::string& dir) {
   Recording rec;
   rec.dir = dir;
   const std::string meta_path = dir + "/meta.json";
+  check_regular(meta_path, kMaxMetaBytes);
   std::ifstream mf(meta_path);
   if (!mf) throw RecordingError(meta_path + ": cannot open (is " + dir + " a recording?)");
   try {
@@ -128,14 +187,23 @@ Recording load_recording(const std::string& dir) {
   rec.verb = rec.meta["verb"].get<std::string>();
 
   const std::string trace_path = dir + "/trace.csv";
-  std::ifstream tf(trace_path);
+  check_regular(trace_path, kMaxTraceBytes);
+  std::ifstream tf(trace_path, std::ios::binary);
   if (!tf) throw RecordingError(trace_path + ": cannot open");
   std::string line;
-  if (!std::getline(tf, line) || line.empty()) {
+  if (!read_line(tf, &line, trace_path, 1) || line.empty()) {
     throw RecordingError(trace_path + ": empty (no header)");
   }
   rec.columns = split(line);
+  std::set<std::string> seen;
   for (const std::string& c : rec.columns) {
+    if (c.empty()) {
+      throw RecordingError(trace_path + ": line 1: a column has no name");
+    }
+    if (!seen.insert(c).second) {
+      throw RecordingError(trace_path + ": line 1: column '" + c +
+                           "' appears twice");
+    }
     if (is_text_column(c)) rec.text[c];
     else rec.num[c];
   }
@@ -145,7 +213,8 @@ Recording load_recording(const std::string& dir) {
     }
   }
   std::size_t line_no = 1;
-  while (std::getline(tf, line)) {
+  double last_t_s = -std::numeric_limits<double>::infinity();
+  while (read_line(tf, &line, trace_path, line_no + 1)) {
     ++line_no;
     if (line.empty()) continue;
     const std::vector<std::string> cells = split(line);
@@ -175,6 +244,19 @@ Recording load_recording(const std::string& dir) {
       }
       rec.num[name].push_back(v);
     }
+    // the clock: finite and strictly increasing, or the recording is not
+    // one (reversed, repeated or zeroed rows)
+    const double t_s = rec.num["t_s"].back();
+    if (!std::isfinite(t_s) || !(t_s > last_t_s)) {
+      throw RecordingError(trace_path + ": line " + std::to_string(line_no) +
+                           ": t_s = " + cells[static_cast<std::size_t>(
+                                            t_index(rec.columns))] +
+                           (std::isfinite(t_s)
+                                ? " does not come after the line before's"
+                                : " is not a finite time") +
+                           "; t_s must increase from row to row");
+    }
+    last_t_s = t_s;
     ++rec.rows;
   }
   if (rec.rows == 0) throw RecordingError(trace_path + ": no rows");

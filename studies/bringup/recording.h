@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -74,8 +75,21 @@ struct Recording {
             std::size_t row, bool xyz = false) const;
 };
 
+// The bounds a recording is read within: meta.json's size, the trace's
+// size (a 3600 s hw record at 1 kHz is about 3 GB) and its longest line.
+inline constexpr std::int64_t kMaxMetaBytes = std::int64_t{1} << 20;
+inline constexpr std::int64_t kMaxTraceBytes = std::int64_t{8} << 30;
+inline constexpr std::size_t kMaxLineBytes = std::size_t{1} << 16;
+
 // Reads DIR/meta.json and DIR/trace.csv. Throws RecordingError naming the
-// file and the problem.
+// file and the problem (and the line, and the column, for the trace):
+// either file not a regular file (a FIFO, a device: refused by type before
+// it is opened) or beyond its size bound; meta.json not JSON or without
+// its verb; the trace without its header or required columns, with a
+// column named twice, a line longer than kMaxLineBytes, a row of the wrong
+// length (but a last row cut short, which is dropped), a cell that is not
+// a number, or a t_s that is not finite and larger than the row before's.
+// CRLF line ends are read as LF.
 Recording load_recording(const std::string& dir);
 
 }  // namespace vmh::bringup

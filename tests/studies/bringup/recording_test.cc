@@ -3,10 +3,12 @@
 #include "studies/bringup/recording.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 namespace vmh::bringup {
 namespace {
@@ -88,6 +90,77 @@ TEST(Recording, BadInputNamesTheFileAndTheCause) {
   const fs::path nojson = make_dir("nojson");
   write(nojson / "meta.json", "{");
   EXPECT_NE(message(nojson).find("not valid JSON"), std::string::npos);
+}
+
+// Saved with CRLF line ends (RFC 4180's own; spreadsheet tools on Windows
+// write them): read as the same recording.
+TEST(Recording, CrlfLineEndsAreRead) {
+  const fs::path d = make_dir("crlf");
+  write(d / "meta.json", "{\"verb\": \"hw record\"}\r\n");
+  std::string header = kHeader;
+  header.insert(header.size() - 1, "\r");
+  write(d / "trace.csv", header +
+                             "0,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\r\n"
+                             "0.001,0.001,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.02,ok,1,2,979\r\n");
+  const Recording r = load_recording(d.string());
+  ASSERT_EQ(r.rows, 2u);
+  EXPECT_DOUBLE_EQ(r.dev_p_mm(1).z(), 979.0);
+  EXPECT_EQ(r.text_col("read_error")[1], "ok");
+  EXPECT_TRUE(r.has("dev_p_z_mm"));
+}
+
+// A corrupt recording is refused, not judged (issue 34): a clock that does
+// not increase (reversed or repeated rows, all zero), a time that is not
+// finite, a column named twice, a line beyond the bound, and files that are
+// not regular files. Each message names the file, the line or the column.
+TEST(Recording, ACorruptRecordingIsRefusedAndNamed) {
+  auto message = [](const fs::path& d) {
+    try {
+      load_recording(d.string());
+    } catch (const RecordingError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string row0 = "0,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n";
+  const std::string row1 = "0.001,0.001,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n";
+  auto with_trace = [&](const std::string& name, const std::string& trace) {
+    const fs::path d = make_dir(name);
+    write(d / "meta.json", R"({"verb": "hw record"})");
+    write(d / "trace.csv", trace);
+    return d;
+  };
+  const auto npos = std::string::npos;
+
+  std::string m = message(with_trace("reversed", std::string(kHeader) + row1 + row0));
+  EXPECT_NE(m.find("trace.csv: line 3: t_s = 0 does not come after"), npos) << m;
+  m = message(with_trace("repeated", std::string(kHeader) + row0 + row0));
+  EXPECT_NE(m.find("line 3: t_s = 0"), npos) << m;
+  m = message(with_trace("nan_time", std::string(kHeader) +
+                                         "nan,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n"));
+  EXPECT_NE(m.find("line 2: t_s = nan is not a finite time"), npos) << m;
+
+  std::string twice = kHeader;
+  twice.replace(twice.find("dev_p_z_mm"), 10, "q1_rad");
+  m = message(with_trace("twice", twice + row0));
+  EXPECT_NE(m.find("column 'q1_rad' appears twice"), npos) << m;
+
+  m = message(with_trace("long", std::string(kHeader) + std::string(kMaxLineBytes + 10, '1') +
+                                     "\n"));
+  EXPECT_NE(m.find("line 2 is longer than"), npos) << m;
+
+  // a FIFO in the trace's place: refused by its type, before any read
+  // (which would block)
+  const fs::path fifo = make_dir("fifo");
+  write(fifo / "meta.json", R"({"verb": "hw record"})");
+  ASSERT_EQ(mkfifo((fifo / "trace.csv").c_str(), 0600), 0);
+  m = message(fifo);
+  EXPECT_NE(m.find("trace.csv: not a regular file (a FIFO)"), npos) << m;
+  // a folder as meta.json
+  const fs::path dirmeta = make_dir("dirmeta");
+  fs::create_directories(dirmeta / "meta.json");
+  m = message(dirmeta);
+  EXPECT_NE(m.find("meta.json: not a regular file (a folder)"), npos) << m;
 }
 
 }  // namespace
