@@ -1,6 +1,7 @@
 #include "studies/report_html.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -51,6 +52,38 @@ std::string td(const std::string& text, const std::string& cls = "") {
 }
 std::string th(const std::string& text) { return "<th>" + escape(text) + "</th>"; }
 
+// What in an SVG would run or load something on the page, "" if nothing:
+// a <script>, an element that embeds a document (foreignObject, iframe,
+// object, embed), an event handler attribute (onload=, onclick=, ...) or
+// a javascript: link. The project's SVG writers make none of these; an SVG
+// read back from a folder (report --reuse) may hold any, and the page
+// promises no scripts.
+std::string active_content(const std::string& svg) {
+  std::string low(svg.size(), ' ');
+  std::transform(svg.begin(), svg.end(), low.begin(), [](char ch) {
+    return static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  });
+  for (const char* tag : {"<script", "<foreignobject", "<iframe", "<object",
+                          "<embed", "javascript:"}) {
+    if (low.find(tag) != std::string::npos) {
+      return tag[0] == '<' ? std::string("a ") + tag + "> element"
+                           : std::string("a javascript: link");
+    }
+  }
+  // on...= after white space: an event handler attribute
+  for (std::size_t i = low.find("on"); i != std::string::npos;
+       i = low.find("on", i + 2)) {
+    if (i == 0 || !std::isspace(static_cast<unsigned char>(low[i - 1]))) continue;
+    std::size_t k = i + 2;
+    while (k < low.size() && std::isalpha(static_cast<unsigned char>(low[k]))) ++k;
+    while (k < low.size() && std::isspace(static_cast<unsigned char>(low[k]))) ++k;
+    if (k > i + 2 && k < low.size() && low[k] == '=') {
+      return "an event handler (" + svg.substr(i, k - i) + "=)";
+    }
+  }
+  return "";
+}
+
 // a figure, or a note where it is missing. `id` names the figure on the page
 // and prefixes every id inside its SVG; `file` is the same SVG's file
 // relative to the report (the browser test draws it standalone and compares).
@@ -59,8 +92,16 @@ std::string figure(const std::string& svg, const std::string& caption,
   std::string s = "<figure id=\"fig-" + escape(id) + "\"" +
                   (file.empty() ? "" : " data-file=\"" + escape(file) + "\"") +
                   ">\n";
-  s += svg.empty() ? "<p class=\"note\">" + escape(caption) + ": not available</p>\n"
-                   : inline_svg(svg, id + "-");
+  const std::string active = active_content(svg);
+  if (svg.empty()) {
+    s += "<p class=\"note\">" + escape(caption) + ": not available</p>\n";
+  } else if (!active.empty()) {
+    s += "<p class=\"note\">" + escape(file.empty() ? caption : file) +
+         ": not shown: it holds " + escape(active) +
+         ", which this page does not carry</p>\n";
+  } else {
+    s += inline_svg(svg, id + "-");
+  }
   return s + "<figcaption>" + escape(caption) + "</figcaption>\n</figure>\n";
 }
 

@@ -282,6 +282,55 @@ TEST(ReportHtmlTest, AFailingClaimIsMarkedAndARenderEmbedded) {
   EXPECT_EQ(t.total, 4);
 }
 
+// An SVG read back from a folder (report --reuse) that would run or load
+// something is not inlined: the page promises no scripts (issue 34). The
+// note names the file and what it holds; the clean figure beside it is
+// inlined as before.
+TEST(ReportHtmlTest, AFigureWithActiveContentIsNotInlined) {
+  const std::string clean =
+      "<svg xmlns=\"http://www.w3.org/2000/svg\"><g><line x1=\"0\"/></g></svg>\n";
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"<svg><script>alert(1)</script></svg>", "a <script> element"},
+      {"<svg><SCRIPT src=\"x.js\"/></svg>", "a <script> element"},
+      {"<svg onload=\"alert(1)\"><g/></svg>", "an event handler (onload=)"},
+      {"<svg><g\n ONCLICK = \"x()\"/></svg>", "an event handler (ONCLICK =)"},
+      {"<svg><a href=\"javascript:alert(1)\"><text>x</text></a></svg>",
+       "a javascript: link"},
+      {"<svg><foreignObject><iframe/></foreignObject></svg>",
+       "a <foreignobject> element"},
+  };
+  for (const auto& [svg, what] : bad) {
+    ReportInputs in;
+    ReportCase c;
+    c.name = "case1";
+    c.summary = {{"thesis_case", 1}, {"claims", {claim("held_near", 0.5, true)}}};
+    c.views_svg = svg;
+    c.history_svg = clean;
+    in.cases.push_back(c);
+    const std::string html = report_html(in);
+    EXPECT_EQ(html.find("alert(1)"), std::string::npos) << svg;
+    EXPECT_EQ(html.find("x.js"), std::string::npos) << svg;
+    EXPECT_NE(html.find("case1/views.svg: not shown: it holds " +
+                        std::string(what == "a <script> element"
+                                        ? "a &lt;script&gt; element"
+                                        : what == "a <foreignobject> element"
+                                              ? "a &lt;foreignobject&gt; element"
+                                              : what)),
+              std::string::npos)
+        << svg;
+    // the clean figure is still on the page
+    EXPECT_NE(html.find("<line x1=\"0\"/>"), std::string::npos) << svg;
+  }
+  // the words alone, outside an attribute or element, are no handler
+  ReportInputs in;
+  ReportCase c;
+  c.name = "case1";
+  c.summary = {{"thesis_case", 1}, {"claims", {claim("held_near", 0.5, true)}}};
+  c.views_svg = "<svg><text x=\"1\">on path, on=off</text></svg>";
+  in.cases.push_back(c);
+  EXPECT_NE(report_html(in).find("on path, on=off"), std::string::npos);
+}
+
 // A claim that holds on one side only: its verdict names the side where it
 // fails, and every side is listed with its value and prediction, the
 // failing one marked; the value, threshold and prediction share one cell.
