@@ -6,10 +6,12 @@
 // The FireWire Omni's packets by hand, for debugging a capture or checking
 // what the driver would send: the codec of hw/firewire/omni_packet.h, no
 // device. HEX is the packet's bytes in order as hex digits (44 bytes for a
-// state packet, 16 for a command), in one word or several (they are joined:
-// "0b 99 00 ..." as a capture tool prints it works too). Each prints one
-// JSON object on stdout. A packet of the wrong length, a non-hex digit or a
-// value that is not a number: exit 2 and one line naming it.
+// state packet, 16 for a command), in one word or several, white space
+// anywhere ignored ("0b 99 00 ..." as a capture tool prints it, quoted or
+// not, works too). Each prints one JSON object on stdout. A packet of the
+// wrong length, a non-hex digit or a value that is not a number: exit 2 and
+// one line naming it.
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -55,8 +57,14 @@ int hex_digit(char c) {
 std::vector<std::uint8_t> parse_hex(const std::vector<std::string>& words,
                                     std::size_t bytes, const std::string& verb,
                                     const char* what) {
+  // white space anywhere is a separator, as a capture tool prints the
+  // bytes, also inside one quoted word ("0b 99 00 ...")
   std::string text;
-  for (const std::string& w : words) text += w;
+  for (const std::string& w : words) {
+    for (char ch : w) {
+      if (!std::isspace(static_cast<unsigned char>(ch))) text += ch;
+    }
+  }
   if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
     text = text.substr(2);
   }

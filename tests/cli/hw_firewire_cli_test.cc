@@ -79,6 +79,16 @@ TEST(HwFirewireCli, DecodeTakesTheBytesInSeveralWords) {
   const auto r = run("hw decode firewire-state " + spaced);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(json::parse(r.out).at("counter"), 258);
+  // one quoted word with spaces and a tab inside, as pasted from a capture
+  // tool's byte dump (issue 34: it was refused as a non-hex digit ' ')
+  std::string pasted;
+  for (std::size_t i = 0; i < kStateHex.size(); i += 2) {
+    pasted += kStateHex.substr(i, 2) + (i % 16 == 14 ? "\t" : " ");
+  }
+  const auto q = run("hw decode firewire-state '" + pasted + "'");
+  ASSERT_EQ(q.exit_code, 0) << q.err;
+  EXPECT_EQ(json::parse(q.out).at("counter"), 258);
+  EXPECT_EQ(json::parse(q.out).at("encoders"), json({-2, 300, -32768}));
 }
 
 TEST(HwFirewireCli, EncodeStateWritesTheSamePacket) {
