@@ -206,6 +206,10 @@ void identify_verb(const IdentifyCliOptions& o) {
     r = bringup::identify(recs, io);
   } catch (const bringup::IdentifyError& e) {
     throw UsageError(e.what());
+  } catch (const sim::SimError& e) {
+    // the scene a recording names (meta.json's emulator.scene) or its
+    // parameters: bad input, as a bad recording is
+    throw UsageError(std::string("identify: the recordings' scene: ") + e.what());
   }
 
   std::ostringstream prov;

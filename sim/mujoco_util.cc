@@ -1,5 +1,7 @@
 #include "sim/mujoco_util.h"
 
+#include <sys/stat.h>
+
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -28,11 +30,30 @@ std::string one_line(const char* err, const char* fallback) {
   return msg;
 }
 
-ModelPtr load_locked(const std::string& path, const mjVFS* vfs = nullptr) {
-  // mj_loadXML's own message for a missing file is terse; say it plainly
+// Refuses what is not a readable regular file, before anything opens it.
+// mj_loadXML's own message for a missing file is terse; this says it
+// plainly. A FIFO would block the reader, a device never end, a folder
+// fail with an XML error that does not say why.
+void require_scene_file(const std::string& path) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) {
+    throw SimError(path + ": cannot open the scene file");
+  }
+  if (!S_ISREG(st.st_mode)) {
+    throw SimError(path + ": not a scene file (" +
+                   (S_ISDIR(st.st_mode)    ? "a folder"
+                    : S_ISFIFO(st.st_mode) ? "a FIFO"
+                    : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                                                                 : "not a regular file") +
+                   ")");
+  }
   if (!std::ifstream(path).good()) {
     throw SimError(path + ": cannot open the scene file");
   }
+}
+
+ModelPtr load_locked(const std::string& path, const mjVFS* vfs = nullptr) {
+  require_scene_file(path);
   char err[1024] = "";
   ModelPtr m(mj_loadXML(path.c_str(), vfs, err, sizeof err));
   if (!m) throw SimError(path + ": " + one_line(err, "MuJoCo could not load it"));
@@ -40,6 +61,7 @@ ModelPtr load_locked(const std::string& path, const mjVFS* vfs = nullptr) {
 }
 
 std::string slurp(const std::string& path) {
+  require_scene_file(path);  // an included file too: never a FIFO
   std::ifstream f(path);
   std::stringstream s;
   s << f.rdbuf();
@@ -91,7 +113,8 @@ struct HeadlessVfs {
 ModelPtr load_model_headless(const std::string& path) {
   install_mujoco_handlers();
   std::lock_guard<std::mutex> lock(xml_mutex());
-  // a missing scene has no includes; load_locked then says it is missing
+  // refused before HeadlessVfs reads it (a FIFO would block that read)
+  require_scene_file(path);
   const HeadlessVfs files(path);
   return load_locked(path, &files.vfs);
 }

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 #include "tests/support/cli_run.h"
 
@@ -122,6 +123,24 @@ TEST(IdentifyEmulator, WritesOnlyWhereItMayAndChecksThatFirst) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(file.string()), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(model));
+
+  // the scene the recording names is a folder, then a FIFO: bad input
+  // (exit 2), named, and the FIFO is not opened (it would block)
+  for (const auto& [scene, what] :
+       {std::pair<fs::path, std::string>{dir, "(a folder)"},
+        std::pair<fs::path, std::string>{fifo, "(a FIFO)"}}) {
+    meta["emulator"]["scene"] = scene.string();
+    {
+      std::ofstream out(rec / "meta.json");
+      out << meta.dump(2);
+    }
+    r = run(base);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(scene.string() + ": not a scene file " + what),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(model));
+  }
 }
 
 TEST(IdentifyEmulator, BadInputIsNamed) {

@@ -7,8 +7,10 @@
 #include "sim/case.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -118,6 +120,21 @@ TEST(Case, RefusesWhatALoopRefusedNamingTheFileAndField) {
   EXPECT_NE(m.find("no_such_field"), npos) << m;
   m = refusal(std::string(VMH_MODELS_DIR) + "/cases/missing.xml", {});
   EXPECT_NE(m.find("missing.xml"), npos) << m;
+}
+
+// Only a regular file is read as a scene: a folder fails by its type, and
+// a FIFO is refused before it is opened (opening it would block).
+TEST(Case, AFolderOrAFifoIsNotAScene) {
+  const std::string dir = ::testing::TempDir() + "vmh_case_not_a_scene";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::string m = refusal(dir, {});
+  EXPECT_NE(m.find(dir + ": not a scene file (a folder)"), std::string::npos) << m;
+  const std::string fifo = dir + "/scene.xml";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  m = refusal(fifo, {});
+  EXPECT_NE(m.find(fifo + ": not a scene file (a FIFO)"), std::string::npos) << m;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
