@@ -24,6 +24,16 @@ fs::path make_dir(const std::string& name) {
 
 void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 
+// the RecordingError's message of reading d, "no error" if it reads
+std::string refusal_of(const fs::path& d) {
+  try {
+    load_recording(d.string());
+  } catch (const RecordingError& e) {
+    return std::string(e.what());
+  }
+  return std::string("no error");
+}
+
 const char* kHeader =
     "t_s,period_s,q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad,tau_sent_1_Nm,"
     "tau_sent_2_Nm,tau_sent_3_Nm,read_error,dev_p_x_mm,dev_p_y_mm,dev_p_z_mm\n";
@@ -67,29 +77,21 @@ TEST(Recording, ALastRowCutShortIsDropped) {
 }
 
 TEST(Recording, BadInputNamesTheFileAndTheCause) {
-  auto message = [](const fs::path& d) {
-    try {
-      load_recording(d.string());
-    } catch (const RecordingError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
   const fs::path none = make_dir("none");
-  EXPECT_NE(message(none).find("meta.json"), std::string::npos);
+  EXPECT_NE(refusal_of(none).find("meta.json"), std::string::npos);
   const fs::path bad = make_dir("bad");
   write(bad / "meta.json", R"({"verb": "hw record"})");
   write(bad / "trace.csv", std::string(kHeader) +
                                "0,0,0.1,x,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n"
                                "0,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n");
-  EXPECT_NE(message(bad).find("'q2_rad': not a number"), std::string::npos) << message(bad);
+  EXPECT_NE(refusal_of(bad).find("'q2_rad': not a number"), std::string::npos) << refusal_of(bad);
   const fs::path nocol = make_dir("nocol");
   write(nocol / "meta.json", R"({"verb": "hw record"})");
   write(nocol / "trace.csv", "t_s,q1_rad\n0,0\n");
-  EXPECT_NE(message(nocol).find("no column 'q6_rad'"), std::string::npos) << message(nocol);
+  EXPECT_NE(refusal_of(nocol).find("no column 'q6_rad'"), std::string::npos) << refusal_of(nocol);
   const fs::path nojson = make_dir("nojson");
   write(nojson / "meta.json", "{");
-  EXPECT_NE(message(nojson).find("not valid JSON"), std::string::npos);
+  EXPECT_NE(refusal_of(nojson).find("not valid JSON"), std::string::npos);
 }
 
 // Saved with CRLF line ends (RFC 4180's own; spreadsheet tools on Windows
@@ -114,14 +116,6 @@ TEST(Recording, CrlfLineEndsAreRead) {
 // finite, a column named twice, a line beyond the bound, and files that are
 // not regular files. Each message names the file, the line or the column.
 TEST(Recording, ACorruptRecordingIsRefusedAndNamed) {
-  auto message = [](const fs::path& d) {
-    try {
-      load_recording(d.string());
-    } catch (const RecordingError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
   const std::string row0 = "0,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n";
   const std::string row1 = "0.001,0.001,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n";
   auto with_trace = [&](const std::string& name, const std::string& trace) {
@@ -132,20 +126,20 @@ TEST(Recording, ACorruptRecordingIsRefusedAndNamed) {
   };
   const auto npos = std::string::npos;
 
-  std::string m = message(with_trace("reversed", std::string(kHeader) + row1 + row0));
+  std::string m = refusal_of(with_trace("reversed", std::string(kHeader) + row1 + row0));
   EXPECT_NE(m.find("trace.csv: line 3: t_s = 0 does not come after"), npos) << m;
-  m = message(with_trace("repeated", std::string(kHeader) + row0 + row0));
+  m = refusal_of(with_trace("repeated", std::string(kHeader) + row0 + row0));
   EXPECT_NE(m.find("line 3: t_s = 0"), npos) << m;
-  m = message(with_trace("nan_time", std::string(kHeader) +
+  m = refusal_of(with_trace("nan_time", std::string(kHeader) +
                                          "nan,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n"));
   EXPECT_NE(m.find("line 2: t_s = nan is not a finite time"), npos) << m;
 
   std::string twice = kHeader;
   twice.replace(twice.find("dev_p_z_mm"), 10, "q1_rad");
-  m = message(with_trace("twice", twice + row0));
+  m = refusal_of(with_trace("twice", twice + row0));
   EXPECT_NE(m.find("column 'q1_rad' appears twice"), npos) << m;
 
-  m = message(with_trace("long", std::string(kHeader) + std::string(kMaxLineBytes + 10, '1') +
+  m = refusal_of(with_trace("long", std::string(kHeader) + std::string(kMaxLineBytes + 10, '1') +
                                      "\n"));
   EXPECT_NE(m.find("line 2 is longer than"), npos) << m;
 
@@ -154,12 +148,12 @@ TEST(Recording, ACorruptRecordingIsRefusedAndNamed) {
   const fs::path fifo = make_dir("fifo");
   write(fifo / "meta.json", R"({"verb": "hw record"})");
   ASSERT_EQ(mkfifo((fifo / "trace.csv").c_str(), 0600), 0);
-  m = message(fifo);
+  m = refusal_of(fifo);
   EXPECT_NE(m.find("trace.csv: not a regular file (a FIFO)"), npos) << m;
   // a folder as meta.json
   const fs::path dirmeta = make_dir("dirmeta");
   fs::create_directories(dirmeta / "meta.json");
-  m = message(dirmeta);
+  m = refusal_of(dirmeta);
   EXPECT_NE(m.find("meta.json: not a regular file (a folder)"), npos) << m;
 }
 
