@@ -11,8 +11,6 @@
 // converge or is poorly conditioned (the JSON says which, and is still
 // printed and written); 2 bad input (a missing directory, not a
 // recording, no motor pulse in any, an unknown --fit name).
-#include <sys/stat.h>
-
 #include <CLI/CLI.hpp>
 #include <cctype>
 #include <chrono>
@@ -192,11 +190,7 @@ void identify_verb(const IdentifyCliOptions& o) {
     const std::filesystem::path model_dir =
         std::filesystem::path(model).parent_path();
     if (!model_dir.empty()) report::check_writable_dir(model_dir.string());
-    struct stat st {};
-    if (lstat(model.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-      throw std::runtime_error(model + ": exists and is not a regular file; "
-                               "it is not replaced");
-    }
+    report::check_replaceable(model);
   } catch (const std::runtime_error& e) {
     throw UsageError(std::string("identify: ") + e.what());
   }

@@ -53,20 +53,28 @@ int write_new_file(const std::string& path, const std::string& text) {
 
 }  // namespace
 
-void write_file_atomically(const std::string& path, const std::string& text) {
+std::string file_kind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a folder";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISLNK(mode)) return "a symbolic link";
+  return "not a regular file";
+}
+
+void check_replaceable(const std::string& path) {
   // the rename would put a file in place of whatever is at `path`: a
-  // device node, a FIFO, a folder's link are refused, not replaced
+  // device node, a FIFO, a folder, a link are refused, not replaced
   struct stat st {};
   if (lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-    throw std::runtime_error(
-        path + ": exists and is not a regular file (" +
-        (S_ISLNK(st.st_mode)   ? "a symbolic link"
-         : S_ISDIR(st.st_mode) ? "a folder"
-         : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
-         : S_ISFIFO(st.st_mode) ? "a FIFO"
-                                : "not a file") +
-        "); it is not replaced");
+    throw std::runtime_error(path + ": exists and is not a regular file (" +
+                             file_kind(st.st_mode) + "); it is not replaced");
   }
+}
+
+void write_file_atomically(const std::string& path, const std::string& text) {
+  check_replaceable(path);
   const std::string tmp = path + ".tmp" + unique_suffix();
   if (const int err = write_new_file(tmp, text)) {
     throw std::runtime_error(path + ": " + os_error(err));

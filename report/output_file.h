@@ -3,9 +3,22 @@
 #ifndef VMHAPTICS_REPORT_OUTPUT_FILE_H_
 #define VMHAPTICS_REPORT_OUTPUT_FILE_H_
 
+#include <sys/types.h>
+
 #include <string>
 
 namespace vmh::report {
+
+// What a path that is not a regular file is, for messages: "a folder",
+// "a FIFO", "a socket", "a character device", "a block device", "a
+// symbolic link" (as lstat sees it), else "not a regular file".
+std::string file_kind(mode_t mode);
+
+// Throws std::runtime_error "<path>: exists and is not a regular file (<its
+// kind>); it is not replaced" unless nothing or a regular file is at `path`
+// (a symbolic link is not followed): what write_file_atomically checks
+// first, for a command that must know before it does its work.
+void check_replaceable(const std::string& path);
 
 // Writes `text` to `path` through a temporary file beside it, named
 // "<path>.tmp-<pid>-<n>" (unique per process and per call, so two processes

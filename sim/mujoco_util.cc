@@ -9,6 +9,7 @@
 #include <regex>
 #include <sstream>
 
+#include "report/output_file.h"
 #include "sim/mujoco_messages.h"
 
 namespace vmh::sim {
@@ -41,11 +42,7 @@ void require_scene_file(const std::string& path) {
   }
   if (!S_ISREG(st.st_mode)) {
     throw SimError(path + ": not a scene file (" +
-                   (S_ISDIR(st.st_mode)    ? "a folder"
-                    : S_ISFIFO(st.st_mode) ? "a FIFO"
-                    : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
-                                                                 : "not a regular file") +
-                   ")");
+                   report::file_kind(st.st_mode) + ")");
   }
   if (!std::ifstream(path).good()) {
     throw SimError(path + ": cannot open the scene file");

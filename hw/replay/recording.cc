@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "controller/device_frame.h"
+#include "report/output_file.h"
 
 namespace vmh::hw::replay {
 namespace {
@@ -25,16 +26,6 @@ namespace fs = std::filesystem;
 constexpr const char* kXyz[] = {"x", "y", "z"};
 
 std::string errno_text(int e) { return std::strerror(e); }
-
-// "a FIFO", "a folder", ...: what a path that is not a regular file is
-std::string kind_of(mode_t m) {
-  if (S_ISDIR(m)) return "a folder";
-  if (S_ISFIFO(m)) return "a FIFO";
-  if (S_ISSOCK(m)) return "a socket";
-  if (S_ISCHR(m)) return "a character device";
-  if (S_ISBLK(m)) return "a block device";
-  return "not a regular file";
-}
 
 std::string bytes_text(std::uint64_t b) {
   char buf[64];
@@ -62,7 +53,7 @@ std::FILE* open_regular(const std::string& path, std::uint64_t max_bytes,
     throw RecordingError(path + ": " + errno_text(errno));
   }
   if (!S_ISREG(st.st_mode)) {
-    throw RecordingError(path + " is " + kind_of(st.st_mode) +
+    throw RecordingError(path + " is " + report::file_kind(st.st_mode) +
                          ", not a regular file");
   }
   if (static_cast<std::uint64_t>(st.st_size) > max_bytes) {
@@ -397,7 +388,7 @@ Recording read_recording(const std::string& folder, const RecordingLimits& limit
   if (!S_ISDIR(st.st_mode)) {
     throw RecordingError("replay: '" + folder + "' is " +
                          (S_ISREG(st.st_mode) ? std::string("a file")
-                                              : kind_of(st.st_mode)) +
+                                              : report::file_kind(st.st_mode)) +
                          ", not a folder; give the folder `vmhaptics hw "
                          "record --out DIR` wrote");
   }

@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -9,6 +10,8 @@
 #include <limits>
 #include <set>
 #include <sstream>
+
+#include "report/output_file.h"
 
 namespace vmh::bringup {
 namespace {
@@ -26,11 +29,7 @@ void check_regular(const std::string& path, std::int64_t max_bytes) {
   if (stat(path.c_str(), &st) != 0) return;  // the open names a missing one
   if (!S_ISREG(st.st_mode)) {
     throw RecordingError(path + ": not a regular file (" +
-                         (S_ISFIFO(st.st_mode)   ? "a FIFO"
-                          : S_ISDIR(st.st_mode)  ? "a folder"
-                          : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)
-                              ? "a device"
-                              : "not a file") +
+                         report::file_kind(st.st_mode) +
                          "); a recording's files are plain files");
   }
   if (st.st_size > max_bytes) {
@@ -70,14 +69,6 @@ std::vector<std::string> split(const std::string& line) {
   while (std::getline(s, cell, ',')) out.push_back(cell);
   if (!line.empty() && line.back() == ',') out.emplace_back();
   return out;
-}
-
-// where t_s is among the columns (the header has it: checked)
-std::ptrdiff_t t_index(const std::vector<std::string>& columns) {
-  for (std::size_t i = 0; i < columns.size(); ++i) {
-    if (columns[i] == "t_s") return static_cast<std::ptrdiff_t>(i);
-  }
-  return 0;
 }
 
 }  // namespace
@@ -212,6 +203,11 @@ Recording load_recording(const std::string& dir) {
       throw RecordingError(trace_path + ": no column '" + required + "'");
     }
   }
+  // the clock's column, checked row by row below
+  const std::size_t t_cell = static_cast<std::size_t>(
+      std::find(rec.columns.begin(), rec.columns.end(), "t_s") -
+      rec.columns.begin());
+  const std::vector<double>& t_col = rec.num.at("t_s");
   std::size_t line_no = 1;
   double last_t_s = -std::numeric_limits<double>::infinity();
   while (read_line(tf, &line, trace_path, line_no + 1)) {
@@ -246,11 +242,10 @@ Recording load_recording(const std::string& dir) {
     }
     // the clock: finite and strictly increasing, or the recording is not
     // one (reversed, repeated or zeroed rows)
-    const double t_s = rec.num["t_s"].back();
+    const double t_s = t_col.back();
     if (!std::isfinite(t_s) || !(t_s > last_t_s)) {
       throw RecordingError(trace_path + ": line " + std::to_string(line_no) +
-                           ": t_s = " + cells[static_cast<std::size_t>(
-                                            t_index(rec.columns))] +
+                           ": t_s = " + cells[t_cell] +
                            (std::isfinite(t_s)
                                 ? " does not come after the line before's"
                                 : " is not a finite time") +
