@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdlib>
@@ -294,7 +295,16 @@ FAKE_HD_EXPORT HHD hdInitDevice(HDstring config) {
   std::fill(g_force_N, g_force_N + 3, 0.0);
   std::fill(g_applied_Nm, g_applied_Nm + 3, 0.0);
   g_snap = Snapshot{};
-  sample_locked();
+  // as OpenHaptics, which returns from hdInitDevice with the device's
+  // state known: a device behind us on the wall clock (the emulator, on a
+  // busy host) may answer its first reads with a timeout, which left the
+  // position at zero for a test that reads it before the scheduler starts.
+  // Up to 2 s of 1 ms tries; a device that never answers stays invalid.
+  for (int tries = 0; tries < 2000; ++tries) {
+    sample_locked();
+    if (g_snap.valid) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
   return kHandle;
 }
 
