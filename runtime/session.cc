@@ -103,10 +103,6 @@ class Recorder {
   double comm_lost_since_ = -1.0;
 };
 
-std::string signal_name(int s) {
-  return s == SIGINT ? "SIGINT" : s == SIGTERM ? "SIGTERM" : "signal " + std::to_string(s);
-}
-
 }  // namespace
 
 void configure_controller_session(const ControllerParams& params,

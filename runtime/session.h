@@ -31,6 +31,7 @@
 #include "device/servo_chain.h"
 #include "device/tick_timer.h"
 #include "runtime/backend_registry.h"
+#include "runtime/stop.h"
 #include "runtime/trace_writer.h"
 
 namespace vmh::runtime {
@@ -93,12 +94,8 @@ SessionResult run_session(OpenedDevice* dev, const SessionOptions& options);
 
 // The session as it ended, as an error, when it did not end as asked: a
 // device that stopped answering (std::runtime_error, exit 1) or a signal
-// (SignalStop, exit 130 / 143). Call after the outputs are written.
-struct SignalStop : std::runtime_error {
-  SignalStop(const std::string& what, int signo)
-      : std::runtime_error(what), signal(signo) {}
-  int signal;
-};
+// (SignalStop, runtime/stop.h: exit 130 / 143). Call after the outputs are
+// written.
 void raise_if_cut_short(const SessionResult& r, const std::string& verb);
 
 // A session left running for another thread to watch (the viewer): the

@@ -1,5 +1,7 @@
-// StopSignals: a raised SIGINT or SIGTERM is recorded, not fatal, and the
-// handler that was there before comes back afterwards.
+// StopSignals: a raised SIGINT or SIGTERM is recorded, not fatal, the first
+// one is the one named, instances nest (a session inside a verb that
+// listens), and the handler that was there before comes back when the last
+// one goes.
 #include "device/stop_signal.h"
 
 #include <gtest/gtest.h>
@@ -66,11 +68,62 @@ TEST(StopSignals, ANewInstanceStartsClear) {
   EXPECT_FALSE(again.requested());
 }
 
-TEST(StopSignals, OnlyOneAtATime) {
+// SIGINT, SIGINT, SIGTERM: the first one is named (issue 34: the last one
+// was, so a Ctrl-C followed by a kill exited 143)
+TEST(StopSignals, TheFirstSignalIsNamed) {
   StopSignals s;
-  EXPECT_THROW(StopSignals second, std::logic_error);
+  raise(SIGINT);
+  raise(SIGINT);
   raise(SIGTERM);
-  EXPECT_EQ(s.signal_number(), SIGTERM);  // the first still works
+  EXPECT_EQ(s.signal_number(), SIGINT);
+  EXPECT_EQ(stop_signal_number(), SIGINT);
+}
+
+// SIGINT and SIGTERM pending at once (sent within a few ms to a process
+// not scheduled in between): the kernel sets up SIGINT's handler first;
+// SIGTERM's must not be set up on top of it and run first
+TEST(StopSignals, TheFirstSignalIsNamedWhenBothArePending) {
+  StopSignals s;
+  sigset_t both, old;
+  sigemptyset(&both);
+  sigaddset(&both, SIGINT);
+  sigaddset(&both, SIGTERM);
+  ASSERT_EQ(pthread_sigmask(SIG_BLOCK, &both, &old), 0);
+  raise(SIGINT);
+  raise(SIGTERM);
+  EXPECT_EQ(s.signal_number(), 0);  // not delivered yet
+  ASSERT_EQ(pthread_sigmask(SIG_SETMASK, &old, nullptr), 0);  // both now
+  EXPECT_EQ(s.signal_number(), SIGINT);
+}
+
+// an inner instance shares the outer's flag both ways, and its end leaves
+// the handlers installed
+TEST(StopSignals, InstancesNest) {
+  StopSignals outer;
+  raise(SIGTERM);
+  {
+    StopSignals inner;
+    EXPECT_EQ(inner.signal_number(), SIGTERM);  // came before it
+    raise(SIGINT);
+    EXPECT_EQ(inner.signal_number(), SIGTERM);
+  }
+  EXPECT_NE(current_handler(SIGINT), SIG_DFL);
+  raise(SIGINT);  // still caught
+  EXPECT_EQ(outer.signal_number(), SIGTERM);
+}
+
+// the free functions read the same flag, and nothing while none lives
+TEST(StopSignals, StopRequestedWithoutAnInstance) {
+  EXPECT_FALSE(stop_requested());
+  {
+    StopSignals s;
+    EXPECT_FALSE(stop_requested());
+    raise(SIGTERM);
+    EXPECT_TRUE(stop_requested());
+    EXPECT_EQ(stop_signal_number(), SIGTERM);
+  }
+  EXPECT_FALSE(stop_requested());
+  EXPECT_EQ(stop_signal_number(), 0);
 }
 
 TEST(StopSignals, ThePreviousHandlersAreRestored) {
