@@ -12,7 +12,20 @@
 // pass, value, threshold, unit}), skipped checks, suspected_faults (names
 // from docs/bringup.md's vocabulary) with their evidence, sections' detail
 // and figures. Exit 0 when every check passes; 1 when one fails (the JSON
-// is printed first); 2 on bad input (a directory that is not a recording).
+// is printed first); 2 on bad input (a directory that is not a recording,
+// an --out that cannot be its output: see below); 130 / 143 SIGINT /
+// SIGTERM (nothing written, --out left as it was, unless the signal came
+// after the set was in place: then the set is whole).
+//
+// --out DIR is one output set (report/output_file.h): compare.json and each
+// recording's figures, in DIR/<recording's name>/, are written into a
+// private folder beside DIR which then replaces DIR whole; a reader sees
+// the previous set or the new one, and of two runs at once the last to
+// finish wins. A recording's name is its folder's last name reduced to
+// [A-Za-z0-9._-], made unique by "-2", "-3", ... in the order given (a/rec
+// and b/rec: rec and rec-2). Since DIR is replaced, compare refuses a DIR
+// that holds one of its recordings, or a folder with files in it but no
+// compare.json (not an earlier compare's output).
 #include "cli/compare.h"
 
 #include <algorithm>
@@ -25,7 +38,9 @@
 #include <vector>
 
 #include "cli/args.h"
+#include "device/stop_signal.h"
 #include "runtime/json_util.h"
+#include "runtime/stop.h"
 #include "report/output_file.h"
 #include "sim/mujoco_util.h"
 #include "studies/bringup/compare_check.h"
@@ -86,24 +101,126 @@ void merge_delays(std::vector<bringup::SuspectedFault>* faults) {
   }
 }
 
-// where a recording's figures go: DIR/<recording's folder name>/
-std::string figure_dir(const CompareOptions& o, const Recording& r) {
-  if (o.out.empty()) return {};
-  std::string name = fs::path(r.dir).filename().string();
-  if (name.empty()) name = fs::path(r.dir).parent_path().filename().string();
-  const fs::path d = fs::path(o.out) / name;
-  fs::create_directories(d);
-  return d.string();
+// A recording's name among the figure folders: its folder's last name with
+// anything outside [A-Za-z0-9._-] as '_' (a leading '.' too, so that it is
+// not hidden), "recording" if nothing is left, and "-2", "-3", ... after a
+// name already taken (compare.json's name included).
+std::string figure_folder_name(const std::string& dir,
+                               std::set<std::string>* taken) {
+  fs::path p = fs::path(dir).lexically_normal();
+  if (!p.has_filename()) p = p.parent_path();
+  std::string name = p.filename().string();
+  if (name == "." || name == "..") {
+    name = fs::weakly_canonical(fs::absolute(dir)).filename().string();
+  }
+  for (char& ch : name) {
+    const auto u = static_cast<unsigned char>(ch);
+    const bool safe = (u >= 'a' && u <= 'z') || (u >= 'A' && u <= 'Z') ||
+                      (u >= '0' && u <= '9') || ch == '.' || ch == '_' ||
+                      ch == '-';
+    if (!safe) ch = '_';
+  }
+  if (!name.empty() && name[0] == '.') name[0] = '_';
+  if (name.size() > 100) name.resize(100);
+  if (name.empty()) name = "recording";
+  std::string unique = name;
+  for (int k = 2; taken->count(unique) > 0; ++k) {
+    unique = name + "-" + std::to_string(k);
+  }
+  taken->insert(unique);
+  return unique;
+}
+
+// --out as a path whose last name is the set's folder ("X/" is X), or a
+// UsageError when it names none ("", ".", "/") or cannot be replaced by
+// compare's set (a file, a folder holding one of `recs`, a folder with
+// files but no compare.json)
+std::string check_out(const std::string& out, const std::vector<Recording>& recs) {
+  fs::path p = fs::path(out).lexically_normal();
+  if (!p.has_filename() && p.has_parent_path() && p != p.root_path()) {
+    p = p.parent_path();
+  }
+  const std::string last = p.filename().string();
+  if (out.empty() || last.empty() || last == "." || last == "..") {
+    throw UsageError("compare: --out '" + out +
+                     "' names no folder of its own (compare replaces its "
+                     "--out folder whole; give e.g. out/compare)");
+  }
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(p, ec);
+  if (!ec && fs::exists(st) && !fs::is_directory(st)) {
+    throw UsageError("compare: --out '" + out + "' is not a folder (it is " +
+                     (fs::is_symlink(st) ? "a symbolic link" : "a file") + ")");
+  }
+  const fs::path where = fs::weakly_canonical(fs::absolute(p), ec);
+  for (const Recording& r : recs) {
+    std::error_code rec_ec;
+    const fs::path rec = fs::weakly_canonical(fs::absolute(r.dir), rec_ec);
+    const auto [end, rest] =
+        std::mismatch(where.begin(), where.end(), rec.begin(), rec.end());
+    if (!ec && !rec_ec && end == where.end()) {
+      throw UsageError("compare: --out '" + out + "' holds the recording " +
+                       r.dir + " (compare replaces its --out folder whole)");
+    }
+  }
+  if (fs::is_directory(st) && !fs::is_empty(p, ec) &&
+      !fs::is_regular_file(p / "compare.json", ec)) {
+    throw UsageError("compare: --out '" + out +
+                     "' is a folder with files in it but no compare.json: not "
+                     "an earlier compare's output, and compare replaces its "
+                     "--out folder whole");
+  }
+  return p.string();
 }
 
 void compare(const CompareOptions& o) {
   if (o.dirs.empty()) throw UsageError("compare: give at least one recording directory");
+  // SIGINT / SIGTERM only set a flag from here on (device/stop_signal.h),
+  // polled between recordings and sections and before the set is put in
+  // place: a stopped compare leaves --out as it was
+  StopSignals signals;
+  const std::string nothing = "; nothing written";
   std::vector<Recording> recs;
   try {
-    for (const std::string& d : o.dirs) recs.push_back(bringup::load_recording(d));
+    for (const std::string& d : o.dirs) {
+      runtime::throw_if_stopped("compare", nothing);
+      recs.push_back(bringup::load_recording(d));
+    }
   } catch (const bringup::RecordingError& e) {
     throw UsageError(std::string("compare: ") + e.what());
   }
+  runtime::throw_if_stopped("compare", nothing);
+
+  // the set: each recording's figures in <its name>/ of a private folder,
+  // which replaces --out whole once compare.json is beside them
+  std::unique_ptr<report::OutputSet> set;
+  std::string out_dir;
+  std::vector<std::string> folder_names;  // of each recording's figures
+  if (!o.out.empty()) {
+    out_dir = check_out(o.out, recs);
+    try {
+      set = std::make_unique<report::OutputSet>(out_dir);
+    } catch (const std::runtime_error& e) {
+      throw UsageError("compare: --out '" + o.out + "': " + e.what());
+    }
+    std::set<std::string> taken{"compare.json"};
+    for (const Recording& r : recs) {
+      folder_names.push_back(figure_folder_name(r.dir, &taken));
+    }
+  }
+  // where recording i's figures are written now (empty: none), and the
+  // name they will have once the set is in place
+  auto figure_dir = [&](std::size_t i) -> std::string {
+    if (!set) return {};
+    return (fs::path(set->temp_dir()) / folder_names[i]).string();
+  };
+  auto shown = [&](const std::string& written) -> std::string {
+    if (!set) return written;
+    const std::string tmp = set->temp_dir() + "/";
+    return written.rfind(tmp, 0) == 0
+               ? (fs::path(out_dir) / written.substr(tmp.size())).string()
+               : written;
+  };
 
   std::vector<CompareSection> sections;
   // The readings' map and the kinematics are judged on the recording that
@@ -133,7 +250,8 @@ void compare(const CompareOptions& o) {
   try {
     for (std::size_t i = 0; i < recs.size(); ++i) {
       const Recording& r = recs[i];
-      const std::string figs = figure_dir(o, r);
+      const std::string figs = figure_dir(i);
+      runtime::throw_if_stopped("compare", nothing);
       if (judge_kinematics[i]) {
         sections.push_back(bringup::compare_kinematics(r, figs));
       } else {
@@ -145,15 +263,18 @@ void compare(const CompareOptions& o) {
                              r.dir});
         sections.push_back(k);
       }
+      runtime::throw_if_stopped("compare", nothing);
       sections.push_back(bringup::compare_jacobian(r, shared, figs));
       if (r.verb == "hw motor-test") {
         bringup::ForceOptions fo;
         if (!o.scene.empty()) fo.scene = o.scene;
+        runtime::throw_if_stopped("compare", nothing);
         sections.push_back(bringup::compare_force_direction(r, shared, fo, figs));
       }
       if (r.verb == "hw run") {
         sections.push_back(bringup::compare_force_mapping(r));
         bringup::ReplayOptions ro;
+        runtime::throw_if_stopped("compare", nothing);
         sections.push_back(bringup::compare_closed_loop(r, ro, figs));
       }
     }
@@ -182,7 +303,7 @@ void compare(const CompareOptions& o) {
     for (const bringup::SkippedCheck& k : s.skipped) {
       skipped.push_back({{"name", k.name}, {"reason", k.reason}, {"recording", k.recording}});
     }
-    for (const std::string& f : s.figures) figures.push_back(f);
+    for (const std::string& f : s.figures) figures.push_back(shown(f));
     if (!s.detail.empty()) detail.push_back({{"section", s.name}, {"detail", s.detail}});
   }
   for (const bringup::SuspectedFault& f : all_faults) {
@@ -190,11 +311,14 @@ void compare(const CompareOptions& o) {
     if (seen.insert(f.name).second) faults.push_back(f.name);
   }
   Json recordings = Json::array();
-  for (const Recording& r : recs) {
+  for (std::size_t i = 0; i < recs.size(); ++i) {
+    const Recording& r = recs[i];
     recordings.push_back({{"dir", r.dir}, {"verb", r.verb}, {"rows", r.rows},
-                          {"joint_excursion_rad", excitation[&r - recs.data()]},
+                          {"joint_excursion_rad", excitation[i]},
                           {"reports_transform", r.has_transform()},
-                          {"reports_jacobian", r.has_jacobian()}});
+                          {"reports_jacobian", r.has_jacobian()},
+                          {"figures_dir", set ? Json((fs::path(out_dir) / folder_names[i]).string())
+                                              : Json(nullptr)}});
   }
   Json out{{"recordings", recordings},
            {"pass", failed == 0},
@@ -205,9 +329,14 @@ void compare(const CompareOptions& o) {
            {"evidence", evidence},
            {"figures", figures},
            {"detail", detail}};
-  if (!o.out.empty()) {
-    report::write_file_in(o.out, "compare.json", dump_readable(out) + "\n");
+  runtime::throw_if_stopped("compare", nothing);
+  if (set) {
+    set->write("compare.json", dump_readable(out) + "\n");
+    set->commit();
   }
+  // a signal while the set went in: it is whole, and the exit says so
+  runtime::throw_if_stopped(
+      "compare", set ? "; " + out_dir + " was already written whole" : nothing);
   std::cout << dump_readable(out) << '\n';
   if (failed > 0) {
     std::string names;
@@ -229,7 +358,10 @@ void register_compare(CLI::App* app) {
       "(docs/bringup.md)");
   cmd->add_option("recordings", o->dirs, "recording directories (DIR/meta.json, DIR/trace.csv)")
       ->required();
-  cmd->add_option("--out", o->out, "write DIR/compare.json and the figures");
+  cmd->add_option("--out", o->out,
+                  "write DIR/compare.json and the figures, DIR/<recording>/*.svg, "
+                  "as one set that replaces DIR whole (a new or empty folder, "
+                  "or an earlier compare's)");
   cmd->add_option("--scene", o->scene,
                   "the scene to predict a motor test with when the recording "
                   "does not name one (default models/cases/case1.xml, the emulator's)");

@@ -10,7 +10,9 @@
 // (runtime/session.h); this file parses, calls and prints. Exit codes: 0
 // done; 2 bad usage, an unusable --out, or a device that cannot be opened
 // (nothing written); 1 the device stopped answering (trace kept, zero
-// torque sent); 130 / 143 SIGINT / SIGTERM (trace kept, zero torque sent).
+// torque sent); 130 / 143 SIGINT / SIGTERM (trace kept, zero torque sent;
+// record and motor-test catch them from the start: one before the
+// session writes nothing, one after it lets the set go in whole).
 #include "cli/hw.h"
 
 #include <cmath>
@@ -21,6 +23,8 @@
 #include "cli/hw_common.h"
 #include "cli/hw_usb.h"
 #include "controller/device_frame.h"
+#include "device/stop_signal.h"
+#include "runtime/stop.h"
 #include "runtime/meta.h"
 
 namespace vmh::cli {
@@ -99,7 +103,9 @@ void probe(const RecordOptions& o) {
 void record(const RecordOptions& o) {
   // a day at most: the recording streams to disk, one row a tick
   check_seconds("hw record: --duration", o.duration_s, 0.0, 86400.0);
+  StopSignals signals;  // for the whole verb; the session shares it
   auto set = hw_output_set("record", o.out, o.out_given());
+  runtime::throw_if_stopped("hw record", "; nothing written");
   runtime::OpenedDevice dev = open_hw_device(o.common, "tour");
   runtime::SessionOptions so = session_options(o.common, "record");
   so.chain.mode = ChainMode::kRecord;
@@ -117,6 +123,7 @@ void record(const RecordOptions& o) {
   }
   std::cout << dump_readable(out) << '\n';
   runtime::raise_if_cut_short(r, "hw record");
+  runtime::throw_if_stopped("hw record", "; after its session");
 }
 
 void motor_test(const RecordOptions& o) {
@@ -129,7 +136,9 @@ void motor_test(const RecordOptions& o) {
   if (!(o.ms > 0.0) || o.ms > 2000.0) {
     throw UsageError("hw motor-test: --ms must be in (0, 2000]");
   }
+  StopSignals signals;  // for the whole verb; the session shares it
   auto set = hw_output_set("motor-test", o.out, o.out_given());
+  runtime::throw_if_stopped("hw motor-test", "; nothing written");
   runtime::OpenedDevice dev = open_hw_device(o.common, "none");
   runtime::SessionOptions so = session_options(o.common, "motor-test");
   so.chain.mode = ChainMode::kMotorTest;
@@ -171,6 +180,7 @@ void motor_test(const RecordOptions& o) {
   }
   std::cout << dump_readable(out) << '\n';
   runtime::raise_if_cut_short(r, "hw motor-test");
+  runtime::throw_if_stopped("hw motor-test", "; after its session");
 }
 
 }  // namespace

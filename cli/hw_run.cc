@@ -12,6 +12,13 @@
 // Omni's parameters both in the emulator's scene and in the case's model.
 // Exit codes as the other hw verbs, and 1 when a claim fails or, on the
 // wall clock, when the session was disturbed so that no claim was judged.
+// SIGINT / SIGTERM are caught from the start: before the session (the
+// scene loading, the device opening) nothing is written and the exit is
+// 130 / 143; during the session it stops there, and the set is written
+// whole with the trace so far (as the other hw verbs); after it (the
+// claims judged on the emulator's truth) the judging finishes, the set is
+// written whole, and then the exit is 130 / 143.
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -21,6 +28,8 @@
 #include "cli/args.h"
 #include "cli/hw.h"
 #include "cli/hw_common.h"
+#include "device/stop_signal.h"
+#include "runtime/stop.h"
 #include "runtime/meta.h"
 #include "sim/scene_fields.h"
 #ifdef VMH_HAVE_SIM
@@ -89,6 +98,9 @@ Json run_on_device(runtime::OpenedDevice* dev, const std::string& scene,
 }
 
 void hw_run(const HwRunArgs& a) {
+  // SIGINT / SIGTERM only set a flag (device/stop_signal.h), for the
+  // whole verb; the session shares it
+  StopSignals signals;
   if (a.duration_given) {
     check_seconds("hw run: --duration", a.duration_s, 0.0, 3600.0);
   }
@@ -139,6 +151,7 @@ void hw_run(const HwRunArgs& a) {
       throw UsageError(std::string("hw run: ") + e.what());
     }
   }
+  runtime::throw_if_stopped("hw run", "; nothing written");
   // a simulated device plays the scene itself, held by its hand script
   runtime::OpenedDevice dev = open_hw_device(
       a.common, "case", sets, backend.simulated ? scene : std::string());
@@ -177,6 +190,11 @@ void hw_run(const HwRunArgs& a) {
   }
   std::cout << dump_readable(summary) << '\n';
   runtime::raise_if_cut_short(r, "hw run");
+  // a signal after the session, while its claims were judged or its set
+  // went in
+  runtime::throw_if_stopped(
+      "hw run", "; after its session" +
+                    (set ? ": the set in " + a.out + " is whole" : std::string()));
   if (summary.contains("claims_judged") && !summary["claims_judged"].get<bool>()) {
     throw std::runtime_error("hw run: claims not judged: " +
                              summary["claims_not_judged_because"].get<std::string>());

@@ -10,7 +10,10 @@
 // Exit codes: 0 a converged, well-conditioned fit; 1 the fit did not
 // converge or is poorly conditioned (the JSON says which, and is still
 // printed and written); 2 bad input (a missing directory, not a
-// recording, no motor pulse in any, an unknown --fit name).
+// recording, no motor pulse in any, an unknown --fit name); 130 / 143
+// SIGINT / SIGTERM: before the model is written nothing is written (the
+// fit polls between its batches of simulations); a signal while the files
+// go out lets them finish (each is replaced whole) and then exits so.
 #include <CLI/CLI.hpp>
 #include <cctype>
 #include <chrono>
@@ -23,7 +26,9 @@
 #include <vector>
 
 #include "cli/args.h"
+#include "device/stop_signal.h"
 #include "runtime/session.h"
+#include "runtime/stop.h"
 #include "runtime/json_util.h"
 #include "report/output_file.h"
 #include "report/svg_chart.h"
@@ -163,6 +168,10 @@ Json result_json(const bringup::IdentifyResult& r, const std::vector<std::string
 
 void identify_verb(const IdentifyCliOptions& o) {
   const auto start = std::chrono::steady_clock::now();
+  // SIGINT / SIGTERM only set a flag (device/stop_signal.h), polled
+  // between recordings, in the fit, and before anything is written
+  StopSignals signals;
+  const std::string nothing = "; nothing written";
   bringup::IdentifyOptions io;
   io.fit = split_names(o.fit);
   // a real device's recording names no scene: the emulator's default one
@@ -172,6 +181,7 @@ void identify_verb(const IdentifyCliOptions& o) {
     if (!std::filesystem::is_directory(d)) {
       throw UsageError("identify: " + d + " is not a directory");
     }
+    runtime::throw_if_stopped("identify", nothing);
     try {
       recs.push_back(bringup::load_recording(d));
     } catch (const bringup::RecordingError& e) {
@@ -216,6 +226,8 @@ void identify_verb(const IdentifyCliOptions& o) {
          << (p.identified ? "" : " (not identified)");
   }
   prov << "; edit " << sim::omni_edit_text(r.edit) << "; " << r.conditioning;
+  const std::string figure = o.out.empty() ? std::string() : fit_figure(r);
+  runtime::throw_if_stopped("identify", nothing);
   const std::filesystem::path model_dir = std::filesystem::path(model).parent_path();
   if (!model_dir.empty()) std::filesystem::create_directories(model_dir);
   bringup::write_calibrated_model(r.edit, sim::models_dir() + "/omni/omni.xml", model, prov.str());
@@ -233,9 +245,12 @@ void identify_verb(const IdentifyCliOptions& o) {
   out["run_time_s"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!o.out.empty()) {
-    report::write_file_in(o.out, "identify_fit.svg", fit_figure(r));
+    report::write_file_in(o.out, "identify_fit.svg", figure);
     report::write_file_in(o.out, "identify.json", dump_readable(out) + "\n");
   }
+  // a signal while the files went out: they are whole, and the exit says so
+  runtime::throw_if_stopped("identify", "; its files were already written (" +
+                                            outputs.dump() + ")");
   std::cout << dump_readable(out) << '\n';
   if (!r.converged) {
     throw std::runtime_error("identify: the fit did not converge in " +

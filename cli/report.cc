@@ -8,7 +8,12 @@
 // takes those already there and runs only what is missing. Prints one JSON
 // object: {report, cases, claims_passed, claims_total, reused, ran, wall_s}.
 // Exit codes: 0 written and every claim passed; 1 a claim failed (the page
-// is still written) or a run failed; 2 bad usage.
+// is still written) or a run failed; 2 bad usage; 130 / 143 SIGINT /
+// SIGTERM: polled between the runs' ticks (as `run`), between the studies
+// and between the cases' figures, and before report.html is written, so
+// that DIR keeps only whole sets and files (the cases' sets complete
+// before the signal, each study's files) and the previous report.html.
+// A signal while report.html goes in lets it finish and then exits so.
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -22,7 +27,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/args.h"
+#include "device/stop_signal.h"
 #include "runtime/json_util.h"
+#include "runtime/stop.h"
 #include "report/output_file.h"
 #include "report/parallel.h"
 #include "report/progress.h"
@@ -80,6 +87,8 @@ studies::RenderFn case_renderer(const fs::path& dir) {
         return std::nullopt;
       }
       return png;
+    } catch (const runtime::SignalStop&) {
+      throw;  // not a reason to draw no picture: the report stops
     } catch (const std::exception& e) {
       *why_not = e.what();
       return std::nullopt;
@@ -178,6 +187,11 @@ std::string map_note(const studies::StabilityOptions& so) {
 void run(const ReportCli& o) {
   if (o.jobs < 0) throw UsageError("--jobs: must be >= 1 (0: one per core)");
   if (o.out.empty()) throw UsageError("--out: give a directory");
+  // SIGINT / SIGTERM only set a flag (device/stop_signal.h); see the exit
+  // codes above for where it is polled
+  StopSignals signals;
+  const std::string kept = "; report.html not written (the sets and files "
+                           "already complete are kept)";
   const auto start = std::chrono::steady_clock::now();
   const int jobs = o.jobs > 0 ? o.jobs : report::core_count();
   const fs::path dir(o.out);
@@ -224,11 +238,14 @@ void run(const ReportCli& o) {
     const std::size_t p_prec = bar.add_part(
         run_precision ? precision.steps_s.size() * precision.integrators.size() + 1 : 0);
     if (!cases.empty()) {
-      studies::run_cases(&cases, {}, dir.string(), jobs, "", bar.part(p_cases));
+      studies::run_cases(&cases, {}, dir.string(), jobs, "", bar.part(p_cases),
+                         [] { return stop_requested(); });
+      runtime::throw_if_stopped("report", kept);
       for (const studies::CaseJob& j : cases) {
         if (!j.error.empty()) throw std::runtime_error("report: " + j.name + ": " + j.error);
       }
     }
+    runtime::throw_if_stopped("report", kept);
     if (run_extremes) {
       studies::ExtremesOptions ex;
       ex.out_dir = study_dir.string();
@@ -236,11 +253,13 @@ void run(const ReportCli& o) {
       ex.progress = bar.part(p_ex);
       studies::run_extremes_study(ex);
     }
+    runtime::throw_if_stopped("report", kept);
     if (run_map) {
       studies::StabilityOptions m = map;
       m.progress = bar.part(p_map);
       studies::run_stability_study(m);
     }
+    runtime::throw_if_stopped("report", kept);
     if (run_precision) {
       // alone, so that its timings do not compete with other runs
       studies::PrecisionOptions p = precision;
@@ -262,7 +281,13 @@ void run(const ReportCli& o) {
   };
 #endif
   for (const sim::CaseEntry& c : sim::thesis_cases()) {
-    in.cases.push_back(studies::load_report_case(dir.string(), c.name, render));
+    runtime::throw_if_stopped("report", kept);
+    try {
+      in.cases.push_back(studies::load_report_case(dir.string(), c.name, render));
+    } catch (const runtime::SignalStop&) {
+      runtime::throw_if_stopped("report", kept);  // named as report's
+      throw;
+    }
     // the force field and the thesis's figures exist only here: kept beside
     // the case's other SVGs,
     // so that they can be opened (and compared) standalone
@@ -295,8 +320,11 @@ void run(const ReportCli& o) {
   h.reused = reused;
   h.ran = ran;
   h.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const std::string page = report::write_file_in(dir.string(), "report.html",
-                                                  studies::report_html(in));
+  const std::string html = studies::report_html(in);
+  runtime::throw_if_stopped("report", kept);
+  const std::string page = report::write_file_in(dir.string(), "report.html", html);
+  // a signal while the page went in: it is whole, and the exit says so
+  runtime::throw_if_stopped("report", "; " + page + " was already written whole");
 
   const studies::ClaimTally tally = studies::tally_claims(in.cases);
   nlohmann::ordered_json out;

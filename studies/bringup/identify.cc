@@ -12,8 +12,10 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
+#include "device/stop_signal.h"
 #include "report/output_file.h"
 #include "report/parallel.h"
+#include "runtime/stop.h"
 #include "sim/mujoco_util.h"
 #include "sim/sensor_model.h"
 #include "studies/bringup/response_sim.h"
@@ -26,6 +28,13 @@ constexpr double kLogBound = 3.0;      // scales kept within e^+-3 (x0.05..x20)
 constexpr double kBadResidual = 1e6;   // a simulation that blew up
 // half a quantization step in weighted units (a step is sqrt(12))
 const double kHalfStep = std::sqrt(3.0);
+
+// a SIGINT or SIGTERM during the fit (device/stop_signal.h): the
+// simulations still queued are skipped and the fit ends here, before the
+// verb writes anything
+void identify_stop_if_asked() {
+  runtime::throw_if_stopped("identify", "; nothing written");
+}
 
 // One pushed stretch of one recording, ready to simulate
 struct Window {
@@ -194,9 +203,11 @@ class Problem {
                                                        static_cast<Eigen::Index>(size_)));
     const std::size_t nw = windows_.size();
     report::parallel_for(edits.size() * nw, threads_, [&](std::size_t task) {
+      if (stop_requested()) return;  // thrown below, on this thread
       const std::size_t e = task / nw, w = task % nw;
       fill(windows_[w], edits[e], offset_[w], &out[e]);
     });
+    identify_stop_if_asked();
     return out;
   }
 
@@ -250,8 +261,10 @@ std::vector<std::vector<Joints>> simulate_all(const Problem& pb,
                                               const sim::OmniModelEdit& e,
                                               int threads) {
   std::vector<std::vector<Joints>> out(pb.windows().size());
-  report::parallel_for(out.size(), threads,
-                       [&](std::size_t w) { out[w] = pb.simulate(w, e); });
+  report::parallel_for(out.size(), threads, [&](std::size_t w) {
+    if (!stop_requested()) out[w] = pb.simulate(w, e);
+  });
+  identify_stop_if_asked();
   return out;
 }
 

@@ -172,7 +172,9 @@ struct IdentifyResult {
 // tau_sent columns, or whose torques are all zero, are ignored with a
 // note. Throws IdentifyError naming the recordings when none has a usable
 // window, naming an unknown fit name, or naming a recording with no scene
-// (and no default_scene).
+// (and no default_scene); runtime::SignalStop (runtime/stop.h) when a
+// SIGINT or SIGTERM came while a StopSignals lives (polled around each
+// batch of simulations, the ones queued skipped).
 IdentifyResult identify(const std::vector<Recording>& recordings,
                         const IdentifyOptions& options);
 
