@@ -5,15 +5,25 @@
 // Runs the case headless and writes one PNG per time (viz/render.h), then
 // prints one JSON object naming them (docs/outputs.md, "render"). Needs an
 // OpenGL context: a display, or Xvfb (`xvfb-run -a vmhaptics render ...`).
-// Exit codes: 0 written; 2 bad usage or bad input (nothing is written);
-// 1 anything else, no OpenGL context included.
+// Exit codes: 0 written; 2 bad usage or bad input, a time past the scene's
+// duration_s included (nothing is written); 1 anything else, no OpenGL
+// context included; 130 / 143 SIGINT / SIGTERM (nothing written, unless
+// the signal came after every image was in place).
+//
+// The images are drawn into a private folder beside DIR and moved into DIR
+// (one rename each) once every one is written: a render stopped or failed
+// half-way adds nothing to DIR.
 #include <CLI/CLI.hpp>
+#include <stdlib.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <iostream>
 
 #include "cli/args.h"
+#include "device/stop_signal.h"
 #include "runtime/json_util.h"
+#include "runtime/stop.h"
 #include "sim/mujoco_util.h"
 #include "studies/run_case.h"
 #include "viz/render.h"
@@ -52,7 +62,45 @@ std::vector<double> parse_times(const std::string& text) {
   return times;
 }
 
+namespace fs = std::filesystem;
+
+// A private folder beside `dir` (".<name>.render-<pid>-XXXXXX", on the same
+// file system, so that its files can be renamed into `dir`), removed with
+// what is left in it when this goes.
+class RenderScratch {
+ public:
+  explicit RenderScratch(const std::string& dir) {
+    fs::path d = fs::path(dir).lexically_normal();
+    if (!d.has_filename() && d.has_parent_path()) d = d.parent_path();
+    const fs::path parent = d.has_parent_path() ? d.parent_path() : fs::path(".");
+    std::error_code ec;
+    fs::create_directories(parent, ec);
+    std::string templ = (parent / ("." + d.filename().string() + ".render-" +
+                                   std::to_string(static_cast<long>(getpid())) +
+                                   "-XXXXXX"))
+                            .string();
+    if (ec || mkdtemp(templ.data()) == nullptr) {
+      throw std::runtime_error("render: cannot create a folder beside '" + dir +
+                               "'" + (ec ? ": " + ec.message() : ""));
+    }
+    path_ = templ;
+  }
+  ~RenderScratch() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  RenderScratch(const RenderScratch&) = delete;
+  RenderScratch& operator=(const RenderScratch&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
 void render_verb(const RenderOptions& o) {
+  // SIGINT / SIGTERM only set a flag (device/stop_signal.h), polled
+  // between frames (viz::render) and before the images are moved in
+  StopSignals signals;
   viz::RenderRequest req;
   req.times_s = parse_times(o.times);
   try {
@@ -75,15 +123,45 @@ void render_verb(const RenderOptions& o) {
   req.overlays = !o.no_overlay;
   req.label = !o.no_label;
   req.out_dir = o.out;
-
-  std::vector<viz::RenderedImage> images;
   try {
-    images = viz::render(req);
+    viz::validate_render_request(req);
   } catch (const viz::RenderInputError& e) {
     throw UsageError(e.what());
-  } catch (const sim::SimError& e) {
-    throw UsageError(std::string("render ") + req.name + ": " + e.what());
   }
+
+  std::vector<viz::RenderedImage> images;
+  {
+    RenderScratch scratch(o.out);
+    req.out_dir = scratch.path();
+    try {
+      images = viz::render(req);
+    } catch (const viz::RenderInputError& e) {
+      throw UsageError(e.what());
+    } catch (const sim::SimError& e) {
+      throw UsageError(std::string("render ") + req.name + ": " + e.what());
+    } catch (const runtime::SignalStop&) {
+      runtime::throw_if_stopped("render", "; nothing written");
+      throw;
+    }
+    runtime::throw_if_stopped("render", "; nothing written");
+    std::error_code ec;
+    fs::create_directories(o.out, ec);
+    if (ec) {
+      throw std::runtime_error("render: cannot create folder '" + o.out +
+                               "': " + ec.message());
+    }
+    for (viz::RenderedImage& img : images) {
+      const fs::path to = fs::path(o.out) / fs::path(img.path).filename();
+      fs::rename(img.path, to, ec);
+      if (ec) {
+        throw std::runtime_error("render: " + to.string() + ": " + ec.message());
+      }
+      img.path = to.string();
+    }
+  }
+  // a signal while the images went in: they are all there, and the exit
+  // says so
+  runtime::throw_if_stopped("render", "; its images were already in " + o.out);
 
   Json j;
   j["scene"] = req.scene_path;
@@ -121,9 +199,8 @@ void register_render(CLI::App* app) {
       ->required();
   cmd->add_option("--t", o->times,
                   "simulated times in s, comma-separated (e.g. 0.5,1,2.5); "
-                  "each >= 0, and past the run's duration the hand holds "
-                  "its last target; each image shows the first servo tick "
-                  "ending at or after its time")
+                  "each in [0, the scene's duration_s]; each image shows the "
+                  "first servo tick ending at or after its time")
       ->required();
   cmd->add_option("--out", o->out,
                   "folder for the images, created if needed: "

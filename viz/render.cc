@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "device/stop_signal.h"
+#include "runtime/stop.h"
 #include "sim/closed_loop.h"
 #include "viz/gl_context.h"
 #include "viz/overlay.h"
@@ -72,6 +74,15 @@ std::vector<RenderedImage> render(const RenderRequest& req) {
   std::sort(times.begin(), times.end());
 
   sim::ClosedLoop loop(req.scene_path, req.overrides, req.model_hook);
+  // past the script's end the hand only holds its last target: a later
+  // time shows nothing new, and a far one (1e6 s) would run for hours
+  const double duration_s = loop.the_case().config().sim.duration_s;
+  if (times.back() > duration_s) {
+    throw RenderInputError("--t: time " + format("%g", times.back()) +
+                           " s is past the scene's duration_s, " +
+                           format("%g", duration_s) + " s (" + req.name +
+                           "'s script ends there)");
+  }
   if (!req.camera.empty()) {
     try {
       camera_id(loop.model(), req.camera);
@@ -97,11 +108,14 @@ std::vector<RenderedImage> render(const RenderRequest& req) {
   for (double t : times) {
     // the first tick end at or after t; at t = 0 one tick, so that the
     // controller's output (the overlay) exists
-    while (!ticked || loop.time_s() < t - 1e-9) {
+    runtime::throw_if_stopped("render");
+    for (long n = 1; !ticked || loop.time_s() < t - 1e-9; ++n) {
       loop.tick(&row);
       loop.throw_if_physics_fault();  // a picture of a reset state says nothing
       ticked = true;
+      if (n % 4096 == 0) runtime::throw_if_stopped("render");
     }
+    runtime::throw_if_stopped("render");
     const auto start = std::chrono::steady_clock::now();
     prims.clear();
     if (req.overlays) {

@@ -29,8 +29,8 @@ struct RenderRequest {
   std::string scene_path;
   std::string name;                    // the case's name, in file names
   std::vector<std::string> overrides;  // name=value, as `run --set`
-  // simulated times, s: finite and >= 0, any order; past the run's
-  // duration the hand holds the script's last target
+  // simulated times, s: in [0, the scene's duration_s] (overrides
+  // applied), any order
   std::vector<double> times_s;
   int width_px = 640;   // [16, 4096]
   int height_px = 480;  // [16, 4096]
@@ -64,9 +64,12 @@ void validate_render_request(const RenderRequest& req);
 
 // Runs the loop and writes one PNG per time, in increasing time, each
 // atomically. Returns them in that order. Throws RenderInputError for bad
-// input (before anything is written), sim::SimError for a bad scene or
-// override, std::runtime_error for no OpenGL context (viz/gl_context.h) or
-// a file that cannot be written.
+// input (before anything is written: a time past the scene's duration_s
+// included), sim::SimError for a bad scene or override, std::runtime_error
+// for no OpenGL context (viz/gl_context.h) or a file that cannot be
+// written, runtime::SignalStop (runtime/stop.h) when a SIGINT or SIGTERM
+// came while a StopSignals lives (polled between frames and every few
+// thousand ticks; the images already written are left to the caller).
 std::vector<RenderedImage> render(const RenderRequest& req);
 
 }  // namespace vmh::viz

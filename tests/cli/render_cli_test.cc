@@ -1,13 +1,19 @@
 // `vmhaptics render` as a user runs it, under a display (Xvfb): the JSON on
 // stdout names PNG files that exist, bad input is exit 2 with one line
-// naming the bad value, no display is exit 1 naming it; nothing is written
-// for either.
+// naming the bad value (a time past the scene's duration included), no
+// display is exit 1 naming it, SIGINT is exit 130; nothing is written for
+// any of these.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "tests/support/cli_run.h"
 
@@ -98,6 +104,65 @@ TEST(RenderCli, BadInputIsExit2NamingIt) {
   expect_refused("case1 --t 1 --height 9000", "--height: 9000");
   expect_refused("case1 --t 1 --camera nosuchcam", "'nosuchcam'");
   expect_refused("case1 --t 1 --set nosuchfield=1", "nosuchfield");
+  // past the script's end (issue 34: --t 1e6 ran for hours), the bound the
+  // scene's duration_s with its overrides
+  expect_refused("case1 --t 0.5,1e6",
+                 "--t: time 1e+06 s is past the scene's duration_s, 20 s");
+  expect_refused("case1 --t 21", "--t: time 21 s is past the scene's duration_s, 20 s");
+  expect_refused("case1 --set duration_s=1 --t 1.5",
+                 "--t: time 1.5 s is past the scene's duration_s, 1 s");
+}
+
+// the images drawn so far, if any, are in a private folder beside --out
+std::vector<fs::path> render_scratch_folders(const fs::path& out) {
+  std::vector<fs::path> found;
+  const std::string prefix = "." + out.filename().string() + ".render-";
+  for (const auto& e : fs::directory_iterator(out.parent_path())) {
+    if (e.path().filename().string().rfind(prefix, 0) == 0) found.push_back(e.path());
+  }
+  return found;
+}
+
+// SIGINT while rendering (sent once the private folder exists): exit 130
+// naming it, and nothing written: no --out, no private folder left
+TEST(RenderCli, ASignalWritesNothing) {
+  const fs::path out = fresh_dir("signal");
+  const fs::path err = fresh_dir("signal_stderr.txt");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int fd = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) dup2(fd, 2);
+    const int null = open("/dev/null", O_WRONLY);
+    if (null >= 0) dup2(null, 1);
+    execl(VMH_CLI_PATH, VMH_CLI_PATH, "render", "case1", "--t", "1,5,10,19.5",
+          "--width", "64", "--height", "48", "--out", out.c_str(),
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  bool started = false;
+  for (int i = 0; i < 60000 && !started; ++i) {
+    started = !render_scratch_folders(out).empty();
+    int status = 0;
+    ASSERT_NE(waitpid(pid, &status, WNOHANG), pid) << vmh::testing::first_line(err);
+    if (!started) usleep(1000);
+  }
+  ASSERT_TRUE(started);
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  const std::string line = vmh::testing::first_line(err);
+  EXPECT_EQ(WEXITSTATUS(status), 130) << line;
+  if (line.find("nothing written") != std::string::npos) {
+    EXPECT_EQ(line, "vmhaptics: interrupted: render stopped by SIGINT; nothing written");
+    EXPECT_FALSE(fs::exists(out));
+  } else {
+    // it had finished drawing: every image is in place
+    EXPECT_EQ(line.rfind("vmhaptics: interrupted: render stopped by SIGINT", 0), 0u) << line;
+    EXPECT_TRUE(fs::exists(out / "case1_t019500ms.png"));
+  }
+  EXPECT_TRUE(render_scratch_folders(out).empty());
 }
 
 // without a display: exit 1 (not bad input), the cause named, nothing
