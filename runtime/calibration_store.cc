@@ -3,10 +3,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "report/output_file.h"
+#include "runtime/recording_reader.h"
 
 namespace vmh::runtime {
 namespace {
@@ -156,25 +155,20 @@ std::string calibration_path(const std::string& serial) {
 
 std::optional<StoredCalibration> load_calibration(const std::string& serial) {
   const std::string path = calibration_path(serial);
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) return std::nullopt;
   // only a regular file (a FIFO would block the read for ever, a device
-  // would never end), and a small one
-  if (!fs::is_regular_file(st)) {
-    throw CalibrationError(path + ": not a regular file");
+  // would never end), and a small one: read as a recording's files are,
+  // without blocking and within the bound
+  bool missing = false;
+  std::string text;
+  try {
+    text = read_regular_file(path, kMaxFileBytes, &missing);
+  } catch (const RecordingError& e) {
+    throw CalibrationError(std::string(e.what()) + " (not a calibration)");
   }
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec || size > kMaxFileBytes) {
-    throw CalibrationError(path + ": larger than 1 MB, not a calibration");
-  }
-  std::ifstream in(path);
-  if (!in) throw CalibrationError(path + ": cannot be read");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  if (missing) return std::nullopt;
   Json j;
   try {
-    j = Json::parse(ss.str());
+    j = Json::parse(text);
   } catch (const std::exception& e) {
     throw CalibrationError(path + ": not JSON (" + e.what() + ")");
   }

@@ -1,5 +1,7 @@
 #include "runtime/meta.h"
 
+#include "runtime/recording_reader.h"
+
 #ifndef VMH_VERSION
 #define VMH_VERSION "unknown"
 #endif
@@ -69,6 +71,7 @@ Json calibration_json(OpenedDevice* dev) {
 Json meta_json(OpenedDevice* dev, const SessionResult& r,
                const std::string& verb, const Json& extra) {
   Json m{{"verb", "hw " + verb},
+         {"recording_format", kRecordingFormat},
          {"software", software_json()},
          {"date_utc", utc_now()},
          {"device", identity_json(dev->backend->identity())},

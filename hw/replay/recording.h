@@ -19,14 +19,13 @@
 // recording session's own doing, not the device's, and are not read.
 //
 // Refused, with the file, line and column named (RecordingError, a
-// DeviceOpenError): a missing folder, a missing trace.csv, a trace.csv (or
-// meta.json) that is not a regular file (checked with stat before it is
-// opened, and opened non-blocking, so a FIFO never hangs the reader), a
-// file over the size bound, a missing required column, a partial optional
-// group, a row with the wrong number of cells, a cell that is not a
-// number, a non-finite value where a good reading needs a number, t_s not
-// increasing, more rows than the row bound, no rows at all, meta.json that
-// is not JSON.
+// DeviceOpenError): a missing folder or trace.csv; whatever the shared
+// reader refuses (runtime/recording_reader.h: a file that is not regular,
+// a bound passed, a header with a column unnamed or named twice, a row of
+// the wrong length, t_s not finite and increasing, meta.json not JSON or
+// not the recording schema); and here a missing required column
+// (q1_rad..q6_rad), a partial optional group, a cell that is not a number,
+// a non-finite value where a good reading needs a number, no rows at all.
 #ifndef VMHAPTICS_HW_REPLAY_RECORDING_H_
 #define VMHAPTICS_HW_REPLAY_RECORDING_H_
 
@@ -38,25 +37,16 @@
 #include "controller/types.h"
 #include "device/device_backend.h"
 #include "device/device_state.h"
+#include "runtime/recording_reader.h"
 
 namespace vmh::hw::replay {
 
-// What a recording may not exceed, so that reading one keeps memory
-// bounded: trace.csv's size and its number of rows. The defaults: 512 MiB
-// and 3,600,000 rows (an hour at 1 kHz); a row then takes at most about
-// 500 bytes in memory (every optional group present), 70 with none.
-struct RecordingLimits {
-  std::uint64_t max_trace_bytes = std::uint64_t{512} << 20;
-  std::size_t max_rows = 3'600'000;
-  std::uint64_t max_meta_bytes = std::uint64_t{16} << 20;
-};
-
-// A recording that cannot be read: the message names the file, and where
-// the fault is in it (file:line:column (name)), and what was wrong.
-class RecordingError : public DeviceOpenError {
- public:
-  using DeviceOpenError::DeviceOpenError;
-};
+// The bounds and the error are the shared reader's
+// (runtime/recording_reader.h): an hour at 1 kHz, 8 GiB of trace, 64 KiB
+// a line, 1 MiB of meta.json. A row takes at most about 500 bytes in
+// memory here (every optional group present), 70 with none.
+using runtime::RecordingLimits;
+using runtime::RecordingError;
 
 struct Recording {
   std::string folder;      // as given, made absolute

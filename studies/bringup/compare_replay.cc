@@ -37,16 +37,28 @@ double gain_scale_of(const Recording& r, const ReplayOptions& o,
     *source = "meta.json";
     return r.meta["gain_scale"].get<double>();
   }
-  std::ifstream f(r.dir + "/summary.json");
-  if (f) {
+  // summary.json as any file of a recording: regular, bounded, read
+  // without blocking (a FIFO there is refused, not waited on)
+  bool missing = false;
+  const std::string text = runtime::read_regular_file(
+      r.dir + "/summary.json", runtime::RecordingLimits{}.max_meta_bytes, &missing);
+  if (!missing) {
+    nlohmann::json s;
     try {
-      const nlohmann::json s = nlohmann::json::parse(f);
-      if (s.contains("gain_scale") && s["gain_scale"].is_number()) {
-        *source = "summary.json";
-        return s["gain_scale"].get<double>();
+      s = nlohmann::json::parse(text);
+    } catch (const nlohmann::json::exception& e) {
+      throw RecordingError(r.dir + "/summary.json: not valid JSON (" +
+                           e.what() + ")");
+    }
+    if (s.is_object() && s.contains("gain_scale")) {
+      const nlohmann::json& g = s["gain_scale"];
+      if (!g.is_number() || !std::isfinite(g.get<double>()) || g.get<double>() < 0) {
+        throw RecordingError(r.dir + "/summary.json: key 'gain_scale': " +
+                             g.dump().substr(0, 40) +
+                             " is not a finite number >= 0");
       }
-    } catch (const nlohmann::json::exception&) {
-      // an unreadable summary says nothing: fall through to the default
+      *source = "summary.json";
+      return g.get<double>();
     }
   }
   *source = "default";

@@ -1,17 +1,9 @@
 #include "studies/bringup/recording.h"
 
-#include <sys/stat.h>
-
-#include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <cstdlib>
-#include <fstream>
-#include <limits>
-#include <set>
-#include <sstream>
+#include <filesystem>
 
-#include "report/output_file.h"
+#include "runtime/recording_reader.h"
 
 namespace vmh::bringup {
 namespace {
@@ -19,56 +11,6 @@ namespace {
 bool is_text_column(const std::string& name) {
   return name == "read_error" || name == "write_error" ||
          name == "safety_flags" || name == "phase";
-}
-
-// Refuses, by its type and size, a file that is not a regular file (a
-// FIFO would block the reader, a device never end) or is larger than
-// max_bytes, before it is opened.
-void check_regular(const std::string& path, std::int64_t max_bytes) {
-  struct stat st {};
-  if (stat(path.c_str(), &st) != 0) return;  // the open names a missing one
-  if (!S_ISREG(st.st_mode)) {
-    throw RecordingError(path + ": not a regular file (" +
-                         report::file_kind(st.st_mode) +
-                         "); a recording's files are plain files");
-  }
-  if (st.st_size > max_bytes) {
-    throw RecordingError(path + ": " + std::to_string(st.st_size) +
-                         " bytes, more than a recording's " +
-                         std::to_string(max_bytes));
-  }
-}
-
-// One line of at most kMaxLineBytes into *line, without its '\n' or a
-// '\r' before it (CRLF line ends, RFC 4180's own, as spreadsheet tools on
-// Windows write them). False at the end of the file; throws on a longer
-// line, naming it.
-bool read_line(std::istream& in, std::string* line, const std::string& path,
-               std::size_t line_no) {
-  line->clear();
-  char c = 0;
-  bool any = false;
-  while (in.get(c)) {
-    any = true;
-    if (c == '\n') break;
-    if (line->size() >= kMaxLineBytes) {
-      throw RecordingError(path + ": line " + std::to_string(line_no) +
-                           " is longer than " + std::to_string(kMaxLineBytes) +
-                           " bytes");
-    }
-    line->push_back(c);
-  }
-  if (!line->empty() && line->back() == '\r') line->pop_back();
-  return any;
-}
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream s(line);
-  while (std::getline(s, cell, ',')) out.push_back(cell);
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
 }
 
 }  // namespace
@@ -162,99 +104,58 @@ Eigen::Matrix<double, 6, 6> Recording::dev_J(std::size_t row) const {
 Recording load_recording(const std::string& dir) {
   Recording rec;
   rec.dir = dir;
+  const runtime::RecordingLimits limits;
   const std::string meta_path = dir + "/meta.json";
-  check_regular(meta_path, kMaxMetaBytes);
-  std::ifstream mf(meta_path);
-  if (!mf) throw RecordingError(meta_path + ": cannot open (is " + dir + " a recording?)");
-  try {
-    rec.meta = nlohmann::ordered_json::parse(mf);
-  } catch (const nlohmann::json::exception& e) {
-    throw RecordingError(meta_path + ": not valid JSON (" + e.what() + ")");
+  bool missing = false;
+  const runtime::RecordingMeta meta =
+      runtime::read_recording_meta(meta_path, limits, &missing);
+  if (missing) {
+    throw RecordingError(meta_path + ": no such file (is " + dir +
+                         " a recording of vmhaptics hw record, motor-test or "
+                         "run?)");
   }
-  if (!rec.meta.is_object() || !rec.meta.contains("verb") ||
-      !rec.meta["verb"].is_string()) {
-    throw RecordingError(meta_path + ": no \"verb\" (not written by vmhaptics hw)");
-  }
-  rec.verb = rec.meta["verb"].get<std::string>();
+  rec.meta = meta.json;
+  rec.verb = meta.verb;
 
   const std::string trace_path = dir + "/trace.csv";
-  check_regular(trace_path, kMaxTraceBytes);
-  std::ifstream tf(trace_path, std::ios::binary);
-  if (!tf) throw RecordingError(trace_path + ": cannot open");
-  std::string line;
-  if (!read_line(tf, &line, trace_path, 1) || line.empty()) {
-    throw RecordingError(trace_path + ": empty (no header)");
+  {
+    // the shared reader names a missing file by its path; say what it is
+    std::error_code ec;
+    if (!std::filesystem::exists(std::filesystem::symlink_status(trace_path, ec))) {
+      throw RecordingError(trace_path + ": no such file (a recording has its "
+                           "trace beside meta.json)");
+    }
   }
-  rec.columns = split(line);
-  std::set<std::string> seen;
+  runtime::TraceReader trace(trace_path, limits);
+  rec.columns = trace.columns();
   for (const std::string& c : rec.columns) {
-    if (c.empty()) {
-      throw RecordingError(trace_path + ": line 1: a column has no name");
-    }
-    if (!seen.insert(c).second) {
-      throw RecordingError(trace_path + ": line 1: column '" + c +
-                           "' appears twice");
-    }
     if (is_text_column(c)) rec.text[c];
     else rec.num[c];
   }
-  for (const char* required : {"t_s", "q1_rad", "q6_rad", "tau_sent_1_Nm"}) {
-    if (!rec.has(required)) {
-      throw RecordingError(trace_path + ": no column '" + required + "'");
-    }
+  for (const char* required : {"q1_rad", "q6_rad", "tau_sent_1_Nm"}) {
+    (void)trace.require(required);
   }
-  // the clock's column, checked row by row below
-  const std::size_t t_cell = static_cast<std::size_t>(
-      std::find(rec.columns.begin(), rec.columns.end(), "t_s") -
-      rec.columns.begin());
-  const std::vector<double>& t_col = rec.num.at("t_s");
-  std::size_t line_no = 1;
-  double last_t_s = -std::numeric_limits<double>::infinity();
-  while (read_line(tf, &line, trace_path, line_no + 1)) {
-    ++line_no;
-    if (line.empty()) continue;
-    const std::vector<std::string> cells = split(line);
-    if (cells.size() != rec.columns.size()) {
-      // a last row cut short by a crash or a full disk: stop there
-      if (tf.peek() == EOF) break;
-      throw RecordingError(trace_path + ": line " + std::to_string(line_no) +
-                           " has " + std::to_string(cells.size()) +
-                           " cells, the header " +
-                           std::to_string(rec.columns.size()));
-    }
+  // the columns' vectors in header order, so that a row is appended
+  // without a lookup per cell
+  std::vector<std::vector<double>*> num_of(rec.columns.size(), nullptr);
+  std::vector<std::vector<std::string>*> text_of(rec.columns.size(), nullptr);
+  for (std::size_t i = 0; i < rec.columns.size(); ++i) {
+    const std::string& c = rec.columns[i];
+    if (is_text_column(c)) text_of[i] = &rec.text.at(c);
+    else num_of[i] = &rec.num.at(c);
+  }
+  while (trace.next()) {
+    const std::vector<std::string_view>& cells = trace.cells();
     for (std::size_t i = 0; i < cells.size(); ++i) {
-      const std::string& name = rec.columns[i];
-      if (is_text_column(name)) {
-        rec.text[name].push_back(cells[i]);
-        continue;
+      if (text_of[i] != nullptr) {
+        text_of[i]->emplace_back(cells[i]);
+      } else {
+        num_of[i]->push_back(trace.number(i));
       }
-      double v = std::nan("");
-      if (!cells[i].empty() && cells[i] != "nan") {
-        char* end = nullptr;
-        v = std::strtod(cells[i].c_str(), &end);
-        if (end == cells[i].c_str() || *end != '\0') {
-          throw RecordingError(trace_path + ": line " + std::to_string(line_no) +
-                               ", column '" + name + "': not a number: '" +
-                               cells[i] + "'");
-        }
-      }
-      rec.num[name].push_back(v);
     }
-    // the clock: finite and strictly increasing, or the recording is not
-    // one (reversed, repeated or zeroed rows)
-    const double t_s = t_col.back();
-    if (!std::isfinite(t_s) || !(t_s > last_t_s)) {
-      throw RecordingError(trace_path + ": line " + std::to_string(line_no) +
-                           ": t_s = " + cells[t_cell] +
-                           (std::isfinite(t_s)
-                                ? " does not come after the line before's"
-                                : " is not a finite time") +
-                           "; t_s must increase from row to row");
-    }
-    last_t_s = t_s;
     ++rec.rows;
   }
-  if (rec.rows == 0) throw RecordingError(trace_path + ": no rows");
+  if (rec.rows == 0) throw RecordingError(trace_path + ": no rows after the header");
   return rec;
 }
 

@@ -17,20 +17,18 @@
 #include <cstdint>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "controller/types.h"
+#include "runtime/recording_reader.h"
 
 namespace vmh::bringup {
 
 // A recording that cannot be read: the message names the file and what
-// was wrong with it (a missing column, a short row, a bad number).
-class RecordingError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+// was wrong with it (a missing column, a short row, a bad number). The
+// shared reader's error (runtime/recording_reader.h).
+using RecordingError = runtime::RecordingError;
 
 struct Recording {
   std::string dir;
@@ -75,21 +73,14 @@ struct Recording {
             std::size_t row, bool xyz = false) const;
 };
 
-// The bounds a recording is read within: meta.json's size, the trace's
-// size (a 3600 s hw record at 1 kHz is about 3 GB) and its longest line.
-inline constexpr std::int64_t kMaxMetaBytes = std::int64_t{1} << 20;
-inline constexpr std::int64_t kMaxTraceBytes = std::int64_t{8} << 30;
-inline constexpr std::size_t kMaxLineBytes = std::size_t{1} << 16;
-
-// Reads DIR/meta.json and DIR/trace.csv. Throws RecordingError naming the
-// file and the problem (and the line, and the column, for the trace):
-// either file not a regular file (a FIFO, a device: refused by type before
-// it is opened) or beyond its size bound; meta.json not JSON or without
-// its verb; the trace without its header or required columns, with a
-// column named twice, a line longer than kMaxLineBytes, a row of the wrong
-// length (but a last row cut short, which is dropped), a cell that is not
-// a number, or a t_s that is not finite and larger than the row before's.
-// CRLF line ends are read as LF.
+// Reads DIR/meta.json and DIR/trace.csv with the shared reader
+// (runtime/recording_reader.h: regular files only, opened without
+// blocking; sizes, lines and rows bounded; meta.json validated against the
+// recording schema; columns named once; rows complete, a last row cut
+// short dropped; t_s finite and increasing; CRLF read as LF) and requires
+// meta.json and the columns q1_rad..q6_rad and tau_sent_1_Nm..3. A cell
+// of a numeric column must be a number ("nan" and "inf" are). Throws
+// RecordingError naming the file, the line and column, or the key.
 Recording load_recording(const std::string& dir);
 
 }  // namespace vmh::bringup

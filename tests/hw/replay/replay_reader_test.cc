@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -116,7 +117,7 @@ TEST(ReplayReader, OptionalGroupsAndMeta) {
   write(d / "trace.csv",
         h + "0,0,0,0,0,0,0,10,-20,30,1,0,0,0,1,0,0,0,1,100,-200,300\n");
   write(d / "meta.json",
-        R"({"device": {"backend": "firewire", "model": "PHANTOM Omni",
+        R"({"verb": "hw record", "device": {"backend": "firewire", "model": "PHANTOM Omni",
             "serial": "11129400000"},
             "session": {"timing": {"nominal_period_us": 1000}}})");
   const Recording r = read_recording(d.string());
@@ -168,13 +169,13 @@ TEST(ReplayReader, RefusesATraceOverTheBounds) {
   const fs::path d = recording("big", 10);
   RecordingLimits l;
   l.max_trace_bytes = 200;
-  EXPECT_HAS(refusal(d, l), "over the replay's bound of 200 bytes");
+  EXPECT_HAS(refusal(d, l), "over the reader's bound of 200 bytes");
   RecordingLimits rows;
   rows.max_rows = 4;
-  EXPECT_HAS(refusal(d, rows), "trace.csv:6: more than 4 rows, the replay's bound");
+  EXPECT_HAS(refusal(d, rows), "trace.csv:6: more than 4 rows, the reader's bound");
   // the defaults, stated
-  EXPECT_EQ(RecordingLimits{}.max_trace_bytes, 512u << 20);
-  EXPECT_EQ(RecordingLimits{}.max_rows, 3600000u);
+  EXPECT_EQ(RecordingLimits{}.max_trace_bytes, std::uint64_t{8} << 30);
+  EXPECT_EQ(RecordingLimits{}.max_rows, 3600001u);
 }
 
 TEST(ReplayReader, NamesAMissingColumn) {
@@ -198,15 +199,15 @@ TEST(ReplayReader, NamesTheCellThatIsNotANumber) {
   const std::string trace = (d / "trace.csv").string();
   EXPECT_HAS(refusal(d), trace + ":3:5 (q3_rad): 'abc' is not a number");
   write(d / "trace.csv", kHeader + "0,0.001,0.1,0.2,0.3,nan,0.5,0.6,ok,0,0\n");
-  EXPECT_HAS(refusal(d), trace + ":2:6 (q4_rad): nan where a good reading");
+  EXPECT_HAS(refusal(d), trace + ":2:6 (q4_rad): nan where a finite number belongs");
   write(d / "trace.csv", kHeader + "0,0.001,0.1,0.2,0.3,0.4,0.5,0.6,ok,0,0.5\n");
-  EXPECT_HAS(refusal(d), trace + ":2:11 (docked): 0.5 is not an integer");
+  EXPECT_HAS(refusal(d), trace + ":2:11 (docked): 0.5 is not a whole number in [0, 1]");
   write(d / "trace.csv", kHeader + "0,0.001,0.1,0.2,0.3,0.4,0.5,0.6,gone,0,0\n");
   EXPECT_HAS(refusal(d), trace + ":2:9 (read_error): 'gone' is not a read error");
   write(d / "trace.csv", kHeader + "0,0.001,0.1,0.2\n");
   EXPECT_HAS(refusal(d), trace + ":2: 4 cells, the header has 11");
   write(d / "trace.csv", kHeader + "nan,0.001,0.1,0.2,0.3,0.4,0.5,0.6,ok,0,0\n");
-  EXPECT_HAS(refusal(d), trace + ":2:1 (t_s): nan where");
+  EXPECT_HAS(refusal(d), trace + ":2:1 (t_s): nan is not a finite time");
   write(d / "trace.csv", kHeader + "0,0.001, 0.1,0.2,0.3,0.4,0.5,0.6,ok,0,0\n");
   EXPECT_HAS(refusal(d), trace + ":2:3 (q1_rad): ' 0.1' is not a number");
 }
@@ -215,10 +216,10 @@ TEST(ReplayReader, RefusesTimeThatDoesNotIncrease) {
   const fs::path d = fresh("time");
   write(d / "trace.csv", kHeader + row(0) + row(1) + row(1));
   const std::string trace = (d / "trace.csv").string();
-  EXPECT_HAS(refusal(d), trace + ":4:1 (t_s): 0.001 is not after the previous "
-                                 "row's 0.001 (time must increase)");
+  EXPECT_HAS(refusal(d), trace + ":4:1 (t_s): 0.001 does not come after the "
+                                 "row before's 0.001");
   write(d / "trace.csv", kHeader + row(2) + row(1));
-  EXPECT_HAS(refusal(d), trace + ":3:1 (t_s): 0.001 is not after");
+  EXPECT_HAS(refusal(d), trace + ":3:1 (t_s): 0.001 does not come after");
 }
 
 TEST(ReplayReader, RefusesAnEmptyRecording) {
@@ -232,7 +233,7 @@ TEST(ReplayReader, RefusesAnEmptyRecording) {
 TEST(ReplayReader, RefusesAMetaThatIsNotJson) {
   const fs::path d = recording("meta", 2);
   write(d / "meta.json", "{not json");
-  EXPECT_HAS(refusal(d), "meta.json: not JSON");
+  EXPECT_HAS(refusal(d), "meta.json: not valid JSON");
   fs::remove(d / "meta.json");
   ASSERT_EQ(::mkfifo((d / "meta.json").c_str(), 0600), 0);
   EXPECT_HAS(refusal(d), "meta.json is a FIFO, not a regular file");

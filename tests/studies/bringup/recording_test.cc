@@ -61,7 +61,7 @@ TEST(Recording, ReadsNumbersTextAndNaN) {
 
 TEST(Recording, TheEmulatorsSceneComesFromMeta) {
   const fs::path d = make_dir("emu");
-  write(d / "meta.json", R"({"verb": "hw motor-test", "emulator": {"scene": "/m/case2.xml"}})");
+  write(d / "meta.json", R"({"verb": "hw record", "emulator": {"scene": "/m/case2.xml"}})");
   write(d / "trace.csv", std::string(kHeader) +
                              "0,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n");
   EXPECT_EQ(load_recording(d.string()).emulator_scene(), "/m/case2.xml");
@@ -72,8 +72,15 @@ TEST(Recording, ALastRowCutShortIsDropped) {
   write(d / "meta.json", R"({"verb": "hw run"})");
   write(d / "trace.csv", std::string(kHeader) +
                              "0,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n"
-                             "0.001,0.001,0.1,0.2\n");
+                             "0.001,0.001,0.1,0.2");  // no line end: cut
   EXPECT_EQ(load_recording(d.string()).rows, 1u);
+  // a short row that has its line end was written short: refused
+  write(d / "trace.csv", std::string(kHeader) +
+                             "0,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n"
+                             "0.001,0.001,0.1,0.2\n");
+  EXPECT_NE(refusal_of(d).find("trace.csv:3: 4 cells, the header has 15"),
+            std::string::npos)
+      << refusal_of(d);
 }
 
 TEST(Recording, BadInputNamesTheFileAndTheCause) {
@@ -84,11 +91,11 @@ TEST(Recording, BadInputNamesTheFileAndTheCause) {
   write(bad / "trace.csv", std::string(kHeader) +
                                "0,0,0.1,x,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n"
                                "0,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n");
-  EXPECT_NE(refusal_of(bad).find("'q2_rad': not a number"), std::string::npos) << refusal_of(bad);
+  EXPECT_NE(refusal_of(bad).find("trace.csv:2:4 (q2_rad): 'x' is not a number"), std::string::npos) << refusal_of(bad);
   const fs::path nocol = make_dir("nocol");
   write(nocol / "meta.json", R"({"verb": "hw record"})");
   write(nocol / "trace.csv", "t_s,q1_rad\n0,0\n");
-  EXPECT_NE(refusal_of(nocol).find("no column 'q6_rad'"), std::string::npos) << refusal_of(nocol);
+  EXPECT_NE(refusal_of(nocol).find("required column 'q6_rad' is missing"), std::string::npos) << refusal_of(nocol);
   const fs::path nojson = make_dir("nojson");
   write(nojson / "meta.json", "{");
   EXPECT_NE(refusal_of(nojson).find("not valid JSON"), std::string::npos);
@@ -127,21 +134,21 @@ TEST(Recording, ACorruptRecordingIsRefusedAndNamed) {
   const auto npos = std::string::npos;
 
   std::string m = refusal_of(with_trace("reversed", std::string(kHeader) + row1 + row0));
-  EXPECT_NE(m.find("trace.csv: line 3: t_s = 0 does not come after"), npos) << m;
+  EXPECT_NE(m.find("trace.csv:3:1 (t_s): 0 does not come after"), npos) << m;
   m = refusal_of(with_trace("repeated", std::string(kHeader) + row0 + row0));
-  EXPECT_NE(m.find("line 3: t_s = 0"), npos) << m;
+  EXPECT_NE(m.find("trace.csv:3:1 (t_s): 0 does not come after the row before's 0"), npos) << m;
   m = refusal_of(with_trace("nan_time", std::string(kHeader) +
                                          "nan,0,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n"));
-  EXPECT_NE(m.find("line 2: t_s = nan is not a finite time"), npos) << m;
+  EXPECT_NE(m.find("trace.csv:2:1 (t_s): nan is not a finite time"), npos) << m;
 
   std::string twice = kHeader;
   twice.replace(twice.find("dev_p_z_mm"), 10, "q1_rad");
   m = refusal_of(with_trace("twice", twice + row0));
   EXPECT_NE(m.find("column 'q1_rad' appears twice"), npos) << m;
 
-  m = refusal_of(with_trace("long", std::string(kHeader) + std::string(kMaxLineBytes + 10, '1') +
+  m = refusal_of(with_trace("long", std::string(kHeader) + std::string(runtime::RecordingLimits{}.max_line_bytes + 10, '1') +
                                      "\n"));
-  EXPECT_NE(m.find("line 2 is longer than"), npos) << m;
+  EXPECT_NE(m.find("trace.csv:2: line longer than the reader's bound of 65536 bytes"), npos) << m;
 
   // a FIFO in the trace's place: refused by its type, before any read
   // (which would block)
@@ -149,12 +156,12 @@ TEST(Recording, ACorruptRecordingIsRefusedAndNamed) {
   write(fifo / "meta.json", R"({"verb": "hw record"})");
   ASSERT_EQ(mkfifo((fifo / "trace.csv").c_str(), 0600), 0);
   m = refusal_of(fifo);
-  EXPECT_NE(m.find("trace.csv: not a regular file (a FIFO)"), npos) << m;
+  EXPECT_NE(m.find("trace.csv is a FIFO, not a regular file"), npos) << m;
   // a folder as meta.json
   const fs::path dirmeta = make_dir("dirmeta");
   fs::create_directories(dirmeta / "meta.json");
   m = refusal_of(dirmeta);
-  EXPECT_NE(m.find("meta.json: not a regular file (a folder)"), npos) << m;
+  EXPECT_NE(m.find("meta.json is a folder, not a regular file"), npos) << m;
 }
 
 }  // namespace
