@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -61,6 +62,77 @@ std::string file_kind(mode_t mode) {
   if (S_ISBLK(mode)) return "a block device";
   if (S_ISLNK(mode)) return "a symbolic link";
   return "not a regular file";
+}
+
+std::string bytes_text(std::uint64_t b) {
+  char buf[64];
+  if (b != 0 && b % (std::uint64_t{1} << 20) == 0) {
+    std::snprintf(buf, sizeof buf, "%llu MiB",
+                  static_cast<unsigned long long>(b >> 20));
+  } else {
+    std::snprintf(buf, sizeof buf, "%llu bytes",
+                  static_cast<unsigned long long>(b));
+  }
+  return buf;
+}
+
+int open_regular_file(const std::string& path, std::uint64_t max_bytes,
+                      bool* missing) {
+  *missing = false;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) {
+      *missing = true;
+      return -1;
+    }
+    throw std::runtime_error(path + ": " + std::strerror(errno));
+  }
+  if (!S_ISREG(st.st_mode)) {
+    throw std::runtime_error(path + " is " + file_kind(st.st_mode) +
+                             ", not a regular file");
+  }
+  if (static_cast<std::uint64_t>(st.st_size) > max_bytes) {
+    throw std::runtime_error(path + " is " +
+                             bytes_text(static_cast<std::uint64_t>(st.st_size)) +
+                             ", over the reader's bound of " + bytes_text(max_bytes));
+  }
+  // O_NONBLOCK: a FIFO put in its place after the stat opens without
+  // waiting for a writer, and the fstat below refuses it
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error(path + ": " + std::strerror(errno));
+  struct stat st2 {};
+  if (::fstat(fd, &st2) != 0 || !S_ISREG(st2.st_mode)) {
+    ::close(fd);
+    throw std::runtime_error(path + " changed into something that is not a "
+                             "regular file while it was opened");
+  }
+  return fd;
+}
+
+std::string read_regular_file(const std::string& path, std::uint64_t max_bytes,
+                              bool* missing) {
+  const int fd = open_regular_file(path, max_bytes, missing);
+  if (fd < 0) return {};
+  std::string text;
+  char buf[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int e = errno;
+      ::close(fd);
+      throw std::runtime_error(path + ": " + std::strerror(e));
+    }
+    if (n == 0) break;
+    text.append(buf, static_cast<std::size_t>(n));
+    if (text.size() > max_bytes) {
+      ::close(fd);
+      throw std::runtime_error(path + " grew over the reader's bound of " +
+                               bytes_text(max_bytes) + " while it was read");
+    }
+  }
+  ::close(fd);
+  return text;
 }
 
 void check_replaceable(const std::string& path) {

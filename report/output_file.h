@@ -5,6 +5,7 @@
 
 #include <sys/types.h>
 
+#include <cstdint>
 #include <string>
 
 namespace vmh::report {
@@ -19,6 +20,26 @@ std::string file_kind(mode_t mode);
 // (a symbolic link is not followed): what write_file_atomically checks
 // first, for a command that must know before it does its work.
 void check_replaceable(const std::string& path);
+
+// Reading what a user hands the program (scenes, recordings, stored
+// calibrations) so that no file can hang or exhaust the reader: opens
+// `path` for reading if it is a regular file of at most max_bytes and
+// returns the descriptor (O_RDONLY | O_NONBLOCK | O_CLOEXEC; checked again
+// with fstat once open, so a FIFO swapped in after the stat is refused
+// rather than waited on), or -1 with *missing = true when nothing is
+// there. Throws std::runtime_error "<path> is a FIFO, not a regular file",
+// "<path> is N bytes, over the reader's bound of M", or the OS error.
+int open_regular_file(const std::string& path, std::uint64_t max_bytes,
+                      bool* missing);
+
+// The whole of such a file, the bound checked again as it is read (a file
+// that grows while it is read is refused at the bound). Throws as
+// open_regular_file; *missing as there.
+std::string read_regular_file(const std::string& path, std::uint64_t max_bytes,
+                              bool* missing);
+
+// "N bytes", or "N MiB" for whole MiB: sizes in messages
+std::string bytes_text(std::uint64_t bytes);
 
 // Writes `text` to `path` through a temporary file beside it, named
 // "<path>.tmp-<pid>-<n>" (unique per process and per call, so two processes

@@ -1,7 +1,5 @@
 #include "runtime/recording_reader.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -20,17 +18,7 @@ constexpr std::size_t kReadChunk = std::size_t{1} << 20;
 // the largest finite double: a bound that only says "finite"
 constexpr double kHuge = std::numeric_limits<double>::max();
 
-std::string bytes_text(std::uint64_t b) {
-  char buf[64];
-  if (b != 0 && b % (std::uint64_t{1} << 20) == 0) {
-    std::snprintf(buf, sizeof buf, "%llu MiB",
-                  static_cast<unsigned long long>(b >> 20));
-  } else {
-    std::snprintf(buf, sizeof buf, "%llu bytes",
-                  static_cast<unsigned long long>(b));
-  }
-  return buf;
-}
+using report::bytes_text;
 
 // a cell, shown in a message: at most 40 characters, control characters
 // escaped, so that a binary file's bytes do not end up on the terminal
@@ -131,61 +119,20 @@ class MetaChecker {
 
 int open_regular_file(const std::string& path, std::uint64_t max_bytes,
                       bool* missing) {
-  *missing = false;
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) {
-    if (errno == ENOENT) {
-      *missing = true;
-      return -1;
-    }
-    throw RecordingError(path + ": " + std::strerror(errno));
+  try {
+    return report::open_regular_file(path, max_bytes, missing);
+  } catch (const std::runtime_error& e) {
+    throw RecordingError(e.what());
   }
-  if (!S_ISREG(st.st_mode)) {
-    throw RecordingError(path + " is " + report::file_kind(st.st_mode) +
-                         ", not a regular file");
-  }
-  if (static_cast<std::uint64_t>(st.st_size) > max_bytes) {
-    throw RecordingError(path + " is " +
-                         bytes_text(static_cast<std::uint64_t>(st.st_size)) +
-                         ", over the reader's bound of " + bytes_text(max_bytes));
-  }
-  // O_NONBLOCK: a FIFO put in its place after the stat opens without
-  // waiting for a writer, and the fstat below refuses it
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) throw RecordingError(path + ": " + std::strerror(errno));
-  struct stat st2 {};
-  if (::fstat(fd, &st2) != 0 || !S_ISREG(st2.st_mode)) {
-    ::close(fd);
-    throw RecordingError(path + " changed into something that is not a "
-                         "regular file while it was opened");
-  }
-  return fd;
 }
 
 std::string read_regular_file(const std::string& path, std::uint64_t max_bytes,
                               bool* missing) {
-  const int fd = open_regular_file(path, max_bytes, missing);
-  if (fd < 0) return {};
-  std::string text;
-  char buf[65536];
-  for (;;) {
-    const ssize_t n = ::read(fd, buf, sizeof buf);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int e = errno;
-      ::close(fd);
-      throw RecordingError(path + ": " + std::strerror(e));
-    }
-    if (n == 0) break;
-    text.append(buf, static_cast<std::size_t>(n));
-    if (text.size() > max_bytes) {
-      ::close(fd);
-      throw RecordingError(path + " grew over the reader's bound of " +
-                           bytes_text(max_bytes) + " while it was read");
-    }
+  try {
+    return report::read_regular_file(path, max_bytes, missing);
+  } catch (const std::runtime_error& e) {
+    throw RecordingError(e.what());
   }
-  ::close(fd);
-  return text;
 }
 
 RecordingMeta parse_recording_meta(const Json& j, const std::string& path) {

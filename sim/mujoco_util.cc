@@ -11,6 +11,7 @@
 
 #include "report/output_file.h"
 #include "sim/mujoco_messages.h"
+#include "sim/scene_fields.h"
 
 namespace vmh::sim {
 namespace {
@@ -49,8 +50,48 @@ void require_scene_file(const std::string& path) {
   }
 }
 
+// Bounds a scene before MuJoCo reads it (MuJoCo's own reader would block
+// on an included FIFO, and compiles and steps whatever size it is given):
+// the scene and its includes read as sim/scene_fields.h reads them (regular
+// files, opened without blocking, at most kMaxSceneBytes together, no
+// include cycle), at most kMaxSceneBodies bodies, and every asset file it
+// names that exists a regular file of at most kMaxAssetBytes.
+void check_scene_bounds(const std::string& path) {
+  SceneCensus c;
+  try {
+    c = scan_scene(path);
+  } catch (const ParamError& e) {
+    throw SimError(e.what());
+  }
+  if (c.bodies > kMaxSceneBodies) {
+    throw SimError(path + ": " + std::to_string(c.bodies) +
+                   " bodies with its includes, more than a scene of this "
+                   "testbed may have (" + std::to_string(kMaxSceneBodies) + ")");
+  }
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  for (const std::string& asset : c.assets) {
+    std::vector<std::filesystem::path> where = {dir / asset};
+    for (const std::string& d : c.asset_dirs) where.push_back(dir / d / asset);
+    if (std::filesystem::path(asset).is_absolute()) where = {asset};
+    for (const std::filesystem::path& p : where) {
+      struct stat st {};
+      if (::stat(p.c_str(), &st) != 0) continue;  // MuJoCo names a missing one
+      if (!S_ISREG(st.st_mode)) {
+        throw SimError(path + ": asset '" + asset + "' (" + p.string() + ") is " +
+                       report::file_kind(st.st_mode) + ", not a regular file");
+      }
+      if (static_cast<std::uint64_t>(st.st_size) > kMaxAssetBytes) {
+        throw SimError(path + ": asset '" + asset + "' is " +
+                       report::bytes_text(static_cast<std::uint64_t>(st.st_size)) +
+                       ", over the bound of " + report::bytes_text(kMaxAssetBytes));
+      }
+    }
+  }
+}
+
 ModelPtr load_locked(const std::string& path, const mjVFS* vfs = nullptr) {
   require_scene_file(path);
+  check_scene_bounds(path);
   char err[1024] = "";
   ModelPtr m(mj_loadXML(path.c_str(), vfs, err, sizeof err));
   if (!m) throw SimError(path + ": " + one_line(err, "MuJoCo could not load it"));
@@ -112,6 +153,7 @@ ModelPtr load_model_headless(const std::string& path) {
   std::lock_guard<std::mutex> lock(xml_mutex());
   // refused before HeadlessVfs reads it (a FIFO would block that read)
   require_scene_file(path);
+  check_scene_bounds(path);
   const HeadlessVfs files(path);
   return load_locked(path, &files.vfs);
 }

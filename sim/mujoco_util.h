@@ -6,6 +6,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <stdexcept>
@@ -30,8 +31,19 @@ struct DataDeleter {
 using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
 using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 
+// What a scene may be before it is compiled (besides
+// sim/scene_fields.h's kMaxSceneBytes for its XML and includes together):
+// the bodies of the scene with its includes, and each asset file (mesh,
+// texture, height field, skin) it names.
+inline constexpr int kMaxSceneBodies = 200;
+inline constexpr std::uint64_t kMaxAssetBytes = std::uint64_t{64} << 20;
+
 // Compiles an MJCF file. Throws SimError "<path>: <MuJoCo's message>" when the
-// file is missing or MuJoCo rejects it. Installs the project's MuJoCo error
+// file is missing or MuJoCo rejects it, and before MuJoCo reads it when the
+// scene or a file it includes is not a regular file (a FIFO would block
+// MuJoCo's reader), its XML is over kMaxSceneBytes, it has more than
+// kMaxSceneBodies bodies, an include is a cycle, or an asset file it names
+// is not a regular file or is over kMaxAssetBytes. Installs the project's MuJoCo error
 // and warning handlers first (sim/mujoco_messages.h), as does
 // save_edited_model_xml.
 ModelPtr load_model(const std::string& path);

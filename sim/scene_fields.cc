@@ -5,15 +5,16 @@
 #include <cctype>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
+#include <stdexcept>
+
+#include "report/output_file.h"
 
 namespace vmh::sim {
 namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{64} << 20;
 constexpr int kMaxIncludeDepth = 16;
 
 struct Attribute {
@@ -41,6 +42,7 @@ class SceneReader {
   }
 
   std::vector<CustomField> fields;
+  SceneCensus census;
 
  private:
   // the file's identity for cycle detection: device and inode
@@ -50,23 +52,24 @@ class SceneReader {
     return std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
   }
 
-  static std::string load(const std::string& path) {
-    std::error_code ec;
-    const fs::file_status st = fs::status(path, ec);
-    if (ec || !fs::exists(st)) throw ParamError(path + ": no such file");
-    // a FIFO or a device would block the read or never end
-    if (!fs::is_regular_file(st)) {
-      throw ParamError(path + ": not a regular file (a scene is an MJCF file)");
+  // the file's text: a regular file only (a FIFO or a device would block
+  // the read or never end), opened without blocking, within the bound
+  std::string load(const std::string& path) {
+    bool missing = false;
+    std::string text;
+    try {
+      text = report::read_regular_file(path, kMaxSceneBytes - census.bytes, &missing);
+    } catch (const std::runtime_error& e) {
+      const bool size = std::string(e.what()).find("bound") != std::string::npos;
+      throw ParamError(std::string(e.what()) +
+                       (size && census.bytes > 0 ? " (a scene's files together are at most " +
+                                               report::bytes_text(kMaxSceneBytes) + ")"
+                                         : std::string()));
     }
-    const std::uintmax_t size = fs::file_size(path, ec);
-    if (ec || size > kMaxFileBytes) {
-      throw ParamError(path + ": larger than 64 MB");
-    }
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw ParamError(path + ": cannot be read");
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
+    if (missing) throw ParamError(path + ": no such file");
+    census.bytes += text.size();
+    census.files.push_back(path);
+    return text;
   }
 
   [[noreturn]] static void fail(const std::string& path, const std::string& text,
@@ -127,6 +130,17 @@ class SceneReader {
   void element(const std::string& name, const std::vector<Attribute>& attrs,
                bool in_custom, int depth, const std::string& path,
                const std::string& text, std::size_t pos) {
+    if (name == "body") ++census.bodies;
+    if (name == "mesh" || name == "texture" || name == "hfield" || name == "skin") {
+      if (const std::string* file = find(attrs, "file"); file != nullptr && !file->empty()) {
+        census.assets.push_back(*file);
+      }
+    }
+    if (name == "compiler") {
+      for (const char* dir : {"meshdir", "texturedir", "assetdir"}) {
+        if (const std::string* d = find(attrs, dir)) census.asset_dirs.push_back(*d);
+      }
+    }
     if (name == "include") {
       const std::string* file = find(attrs, "file");
       if (file == nullptr || file->empty()) {
@@ -289,6 +303,12 @@ class SceneReader {
 };
 
 }  // namespace
+
+SceneCensus scan_scene(const std::string& scene_path) {
+  SceneReader reader(scene_path);
+  reader.read(scene_path, false, 0);
+  return std::move(reader.census);
+}
 
 std::vector<CustomField> read_scene_fields(const std::string& scene_path) {
   SceneReader reader(scene_path);

@@ -21,17 +21,35 @@
 //
 // Bounds (so that a hostile file cannot hang or exhaust the reader): a
 // regular file only (a FIFO or a device is refused by type before it is
-// opened), at most 64 MB a file, includes nested at most 16 deep and never
-// in a cycle.
+// opened, and opened without blocking), at most kMaxSceneBytes for the
+// scene and its includes together, includes nested at most 16 deep and
+// never in a cycle.
 #ifndef VMHAPTICS_SIM_SCENE_FIELDS_H_
 #define VMHAPTICS_SIM_SCENE_FIELDS_H_
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "sim/case_params.h"
 
 namespace vmh::sim {
+
+// What the scene's files hold together, read as above: what the loader
+// bounds before MuJoCo compiles it (sim/mujoco_util.h).
+inline constexpr std::uint64_t kMaxSceneBytes = std::uint64_t{8} << 20;
+struct SceneCensus {
+  std::vector<std::string> files;  // the scene, then each include as read
+  std::uint64_t bytes = 0;         // their sizes, summed
+  int bodies = 0;                  // <body> elements (the world body is not one)
+  std::vector<std::string> assets;      // file= of <mesh>, <texture>, <hfield>, <skin>
+  std::vector<std::string> asset_dirs;  // <compiler> meshdir, texturedir, assetdir
+};
+
+// The census of a scene and its includes. Throws ParamError as
+// read_scene_fields does (a file not regular, over the bound, malformed,
+// an include cycle).
+SceneCensus scan_scene(const std::string& scene_path);
 
 // Every <custom> <numeric> and <text> of the scene and its includes, in
 // document order (a numeric's value as its numbers, space-separated).

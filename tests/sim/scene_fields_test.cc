@@ -183,5 +183,62 @@ TEST(SceneFields, RefusalsNameTheFileAndWhat) {
   }
 }
 
+// The loader bounds a scene before MuJoCo reads it (issue 34): MuJoCo's
+// own reader would block on an included FIFO and would compile and step a
+// scene of any size. Each refusal is a SimError naming the file and what
+// was wrong, and comes before any compile.
+TEST(SceneBounds, TheLoaderRefusesWhatMuJoCoWouldHangOrDrownOn) {
+  TempMjcfDir dir;
+  const auto refused = [](const std::string& path) {
+    try {
+      (void)load_model(path);
+    } catch (const SimError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const auto has = [](const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+  };
+  // an include that is a FIFO: refused by its type, never opened
+  const std::string fifo = (dir.path() / "part.xml").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::string m = refused(dir.write("with_fifo.xml", "<mujoco><include file=\"part.xml\"/></mujoco>"));
+  EXPECT_TRUE(has(m, "<include file=\"part.xml\">: " + fifo + " is a FIFO, not a regular file")) << m;
+  // a scene that includes itself
+  m = refused(dir.write("self.xml", "<mujoco><include file=\"self.xml\"/></mujoco>"));
+  EXPECT_TRUE(has(m, "includes itself (a cycle)")) << m;
+  // more bodies than the bound (comments do not count)
+  std::string many = "<mujoco><worldbody><!-- <body/> -->";
+  for (int i = 0; i <= kMaxSceneBodies; ++i) many += "<body><geom size=\"0.1\"/></body>";
+  m = refused(dir.write("many.xml", (many + "</worldbody></mujoco>").c_str()));
+  EXPECT_TRUE(has(m, std::to_string(kMaxSceneBodies + 1) + " bodies with its includes")) << m;
+  std::string enough = "<mujoco><worldbody>";
+  for (int i = 0; i < kMaxSceneBodies; ++i) enough += "<body><geom size=\"0.1\"/></body>";
+  EXPECT_EQ(refused(dir.write("enough.xml", (enough + "</worldbody></mujoco>").c_str())), "");
+  // XML over the bound, counted over the scene and its includes together
+  const std::string half(kMaxSceneBytes / 2 + 16, ' ');
+  dir.write("half.xml", ("<mujoco>" + half + "</mujoco>").c_str());
+  m = refused(dir.write("two_halves.xml", ("<mujoco><include file=\"half.xml\"/>" + half +
+                                           "</mujoco>").c_str()));
+  EXPECT_TRUE(has(m, "over the reader's bound")) << m;
+  // an asset that is a FIFO or a folder
+  const std::string mesh = (dir.path() / "m.stl").string();
+  ASSERT_EQ(mkfifo(mesh.c_str(), 0600), 0);
+  m = refused(dir.write("mesh.xml", "<mujoco><asset><mesh name=\"m\" file=\"m.stl\"/></asset></mujoco>"));
+  EXPECT_TRUE(has(m, "asset 'm.stl' (" + mesh + ") is a FIFO, not a regular file")) << m;
+  std::filesystem::create_directories(dir.path() / "tex" / "t.png");
+  m = refused(dir.write("tex.xml", "<mujoco><compiler texturedir=\"tex\"/><asset>"
+                                   "<texture name=\"t\" type=\"2d\" file=\"t.png\"/></asset></mujoco>"));
+  EXPECT_TRUE(has(m, "asset 't.png'") && has(m, "is a folder")) << m;
+  // the headless loader checks the same
+  try {
+    (void)load_model_headless((dir.path() / "with_fifo.xml").string());
+    ADD_FAILURE() << "a scene including a FIFO was loaded headless";
+  } catch (const SimError& e) {
+    EXPECT_TRUE(has(e.what(), "is a FIFO")) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace vmh::sim
