@@ -82,6 +82,24 @@ void check_verbs(CLI::App* app, int argc, char** argv) {
     path += " " + next->get_name();
     app = next;
   }
+  // An option the verb does not have is named before CLI11 parses: CLI11
+  // checks required options first, so `kin fk --qq 0,...` would say only
+  // "--q is required" and hide the typo.
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--") break;  // the rest are positional
+    if (arg.size() < 3 || arg.compare(0, 2, "--") != 0) continue;
+    const std::string name = arg.substr(0, arg.find('='));
+    if (name == "--help" || name == "--help-all" || name == "--version") continue;
+    bool known = false;
+    for (const CLI::App* a = app; a != nullptr && !known; a = a->get_parent()) {
+      known = a->get_option_no_throw(name) != nullptr;
+    }
+    if (!known) {
+      throw vmh::cli::UsageError("'" + path + "' has no option " + name +
+                                 " (see " + path + " --help)");
+    }
+  }
 }
 
 // MuJoCo's warnings of the whole run, one line per kind, on stderr
