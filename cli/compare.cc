@@ -185,6 +185,9 @@ void compare(const CompareOptions& o) {
     for (const std::string& d : o.dirs) {
       runtime::throw_if_stopped("compare", nothing);
       recs.push_back(bringup::load_recording(d));
+      if (const std::string note = bringup::window_note(recs.back()); !note.empty()) {
+        std::cerr << "compare: " << note << '\n';
+      }
     }
   } catch (const bringup::RecordingError& e) {
     throw UsageError(std::string("compare: ") + e.what());
@@ -314,6 +317,7 @@ void compare(const CompareOptions& o) {
   for (std::size_t i = 0; i < recs.size(); ++i) {
     const Recording& r = recs[i];
     recordings.push_back({{"dir", r.dir}, {"verb", r.verb}, {"rows", r.rows},
+                          {"rows_in_trace", r.rows_in_trace},
                           {"joint_excursion_rad", excitation[i]},
                           {"reports_transform", r.has_transform()},
                           {"reports_jacobian", r.has_jacobian()},

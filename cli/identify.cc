@@ -184,6 +184,9 @@ void identify_verb(const IdentifyCliOptions& o) {
     runtime::throw_if_stopped("identify", nothing);
     try {
       recs.push_back(bringup::load_recording(d));
+      if (const std::string note = bringup::window_note(recs.back()); !note.empty()) {
+        std::cerr << "identify: " << note << '\n';
+      }
     } catch (const bringup::RecordingError& e) {
       throw UsageError(std::string("identify: not a recording: ") + e.what());
     }

@@ -208,8 +208,17 @@ void simulate(const Recording& r, const std::string& scene,
     }
     return;
   }
+  // the span compared: the recording's rows (its window, when it was cut
+  // to one); the script as the session ran it, over the session's whole
+  // length (a hand script is laid out over its duration_s)
   const double duration_s = rec.t_s.back();
-  overrides.push_back("duration_s=" + replay_fmt(std::max(duration_s, 1e-3), 9));
+  double script_s = duration_s;
+  if (r.cut_to_window() && r.meta.contains("session") && r.meta["session"].is_object() &&
+      r.meta["session"].contains("duration_s") &&
+      r.meta["session"]["duration_s"].is_number()) {
+    script_s = std::max(duration_s, r.meta["session"]["duration_s"].get<double>());
+  }
+  overrides.push_back("duration_s=" + replay_fmt(std::max(script_s, 1e-3), 9));
   // the gains as hw run scaled them, in the scene's own parameters
   {
     const sim::Case probe = sim::load_case(scene, overrides);
@@ -228,6 +237,7 @@ void simulate(const Recording& r, const std::string& scene,
   TickRecord row;
   while (!loop.finished()) {
     loop.tick(&row);
+    if (row.t_s > duration_s + 1e-9) break;  // past the span compared
     sim.t_s.push_back(row.t_s);
     sim.e_mm.push_back(row.out.e.head<3>().norm());
     sim.F_N.push_back(row.out.force_device_N.norm());

@@ -101,7 +101,7 @@ Eigen::Matrix<double, 6, 6> Recording::dev_J(std::size_t row) const {
   return J;
 }
 
-Recording load_recording(const std::string& dir) {
+Recording load_recording(const std::string& dir, std::size_t max_rows) {
   Recording rec;
   rec.dir = dir;
   const runtime::RecordingLimits limits;
@@ -145,6 +145,8 @@ Recording load_recording(const std::string& dir) {
     else num_of[i] = &rec.num.at(c);
   }
   while (trace.next()) {
+    ++rec.rows_in_trace;
+    if (rec.rows >= max_rows) continue;  // checked by next(), not kept
     const std::vector<std::string_view>& cells = trace.cells();
     for (std::size_t i = 0; i < cells.size(); ++i) {
       if (text_of[i] != nullptr) {
@@ -157,6 +159,14 @@ Recording load_recording(const std::string& dir) {
   }
   if (rec.rows == 0) throw RecordingError(trace_path + ": no rows after the header");
   return rec;
+}
+
+std::string window_note(const Recording& r) {
+  if (!r.cut_to_window()) return {};
+  return r.dir + ": judged on its first " + std::to_string(r.rows) + " of " +
+         std::to_string(r.rows_in_trace) +
+         " rows (every row was checked; a verb keeps at most " +
+         std::to_string(kMaxAnalysedRows) + " so that its memory stays bounded)";
 }
 
 }  // namespace vmh::bringup

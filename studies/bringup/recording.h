@@ -37,7 +37,9 @@ struct Recording {
   std::vector<std::string> columns;
   std::map<std::string, std::vector<double>> num;
   std::map<std::string, std::vector<std::string>> text;
-  std::size_t rows = 0;
+  std::size_t rows = 0;           // rows kept: what every analysis reads
+  std::size_t rows_in_trace = 0;  // rows the trace has (all checked)
+  bool cut_to_window() const { return rows_in_trace > rows; }
 
   bool has(const std::string& column) const;
   // throws RecordingError naming the column and the trace
@@ -81,7 +83,19 @@ struct Recording {
 // meta.json and the columns q1_rad..q6_rad and tau_sent_1_Nm..3. A cell
 // of a numeric column must be a number ("nan" and "inf" are). Throws
 // RecordingError naming the file, the line and column, or the key.
-Recording load_recording(const std::string& dir);
+//
+// Memory stays bounded on a long recording: the whole trace is read and
+// checked, but only its first max_rows rows are kept (kMaxAnalysedRows by
+// default: two minutes at 1 kHz, about 120 MB with every column; an hour's
+// `hw run` trace of 119 columns would take 3.4 GB). rows_in_trace says how
+// many the trace has; the verbs report the window.
+inline constexpr std::size_t kMaxAnalysedRows = 120'000;
+Recording load_recording(const std::string& dir,
+                         std::size_t max_rows = kMaxAnalysedRows);
+
+// "DIR: read on its first N of M rows (...)" for a recording cut to its
+// window, "" for one read whole: what compare and identify print
+std::string window_note(const Recording& r);
 
 }  // namespace vmh::bringup
 

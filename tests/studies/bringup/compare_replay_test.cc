@@ -134,6 +134,29 @@ TEST(CompareReplay, UsesTheGainScaleTheRecordingNames) {
           ->pass);
 }
 
+// A recording longer than the verbs keep (load_recording's window) is
+// compared over its window, with the hand's script laid out as the session
+// ran it: over the session's whole duration_s, from meta.json.
+TEST(CompareReplay, AWindowIsComparedAsTheSessionRanIt) {
+  Recording r = run_recording({}, 2.0);
+  const std::size_t keep = r.rows / 2;
+  r.rows_in_trace = r.rows;
+  r.rows = keep;
+  for (auto& [name, col] : r.num) col.resize(keep);
+  for (auto& [name, col] : r.text) col.resize(keep);
+  r.meta["session"] = {{"duration_s", 2.0}};
+  ASSERT_TRUE(r.cut_to_window());
+  const CompareSection s = compare_closed_loop(r, {}, "");
+  for (const char* n : {"closed_loop.error_rms_ratio", "closed_loop.force_rms_ratio"}) {
+    const CompareCheck* c = find(s, n);
+    ASSERT_NE(c, nullptr) << n;
+    // the same scene and script: the ratio is 1 up to the trace's printing
+    EXPECT_NEAR(c->value, 1.0, 1e-3) << n << ": " << c->detail;
+  }
+  EXPECT_NEAR(s.detail["simulation"]["duration_s"].get<double>(),
+              r.col("t_s")[keep - 1], 1e-12);
+}
+
 TEST(CompareReplay, SimulationMatchesItsOwnSceneAndNotAWeakerController) {
   const std::string dir = ::testing::TempDir() + "/compare_replay_fig";
   const CompareSection same =

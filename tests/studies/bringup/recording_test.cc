@@ -164,5 +164,32 @@ TEST(Recording, ACorruptRecordingIsRefusedAndNamed) {
   EXPECT_NE(m.find("meta.json is a folder, not a regular file"), npos) << m;
 }
 
+// A long recording keeps memory bounded: every row is read and checked,
+// only the first max_rows are kept, and the note says so. A bad row past
+// the window is still refused.
+TEST(Recording, ALongTraceIsCheckedWholeAndKeptToItsWindow) {
+  const fs::path d = make_dir("window");
+  write(d / "meta.json", R"({"verb": "hw record"})");
+  std::string trace = kHeader;
+  for (int k = 0; k < 5; ++k) {
+    trace += std::to_string(0.001 * k) + ",0.001,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n";
+  }
+  write(d / "trace.csv", trace);
+  const Recording r = load_recording(d.string(), 2);
+  EXPECT_EQ(r.rows, 2u);
+  EXPECT_EQ(r.rows_in_trace, 5u);
+  EXPECT_EQ(r.col("t_s").size(), 2u);
+  EXPECT_NE(window_note(r).find("judged on its first 2 of 5 rows"), std::string::npos)
+      << window_note(r);
+  EXPECT_EQ(window_note(load_recording(d.string())), "");
+  write(d / "trace.csv", trace + "0.001,0.001,0.1,0.2,0.3,0.4,0.5,0.6,0,0,0.01,ok,1,2,3\n");
+  try {
+    (void)load_recording(d.string(), 2);
+    ADD_FAILURE() << "a clock run backwards past the window was not seen";
+  } catch (const RecordingError& e) {
+    EXPECT_NE(std::string(e.what()).find("trace.csv:7:1 (t_s)"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace vmh::bringup
