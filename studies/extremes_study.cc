@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -204,12 +205,13 @@ void read_limits(const ClosedLoop& loop, ExtremeResult* r) {
 // Ticks the loop until end_s, a row per tick; the wall time and the ticks
 // go in r.
 void run_ticks(ClosedLoop* loop, double end_s, std::vector<TickRecord>* rows,
-               ExtremeResult* r) {
+               ExtremeResult* r, const StopFn& stop) {
   const mjModel* m = loop->model();
   rows->clear();
   rows->reserve(static_cast<std::size_t>(loop->ticks_per_run()));
   const auto start = std::chrono::steady_clock::now();
   while (loop->time_s() < end_s - 0.5 * m->opt.timestep) {
+    throw_if_stop_asked(stop);
     rows->emplace_back();
     loop->tick(&rows->back());
   }
@@ -443,7 +445,7 @@ std::vector<ExtremeScenario> pick_scenarios(const std::vector<std::string>& only
 }  // namespace
 
 ExtremeResult run_extreme(const ExtremeScenario& s,
-                          std::vector<TickRecord>* trace) {
+                          std::vector<TickRecord>* trace, const StopFn& stop) {
   ExtremeResult r;
   r.scenario = s;
   std::string name;
@@ -459,7 +461,7 @@ ExtremeResult run_extreme(const ExtremeScenario& s,
 
   std::vector<TickRecord> local;
   std::vector<TickRecord>& rows = trace != nullptr ? *trace : local;
-  run_ticks(&loop, end_s, &rows, &r);
+  run_ticks(&loop, end_s, &rows, &r, stop);
 
   TickScan scan(loop, end_s, &r);
   for (std::size_t k = 0; k < rows.size(); ++k) scan.add(rows, k);
@@ -473,10 +475,27 @@ ExtremeResult run_extreme(const ExtremeScenario& s,
 
 ExtremesResult run_extremes_study(const ExtremesOptions& o) {
   const std::vector<ExtremeScenario> table = pick_scenarios(o.only);
+  // the series' set (out_dir/extremes, made beside it and put in place at
+  // the end); out_dir itself, if this run makes it, is removed again (if
+  // still empty) when the study stops or fails before writing
+  struct RemoveIfMadeHere {
+    std::string dir;
+    bool keep = false;
+    ~RemoveIfMadeHere() {
+      std::error_code ignored;
+      if (!keep && !dir.empty()) fs::remove(dir, ignored);  // only if empty
+    }
+  } made_here;
+  std::unique_ptr<report::OutputSet> series;
   if (!o.out_dir.empty()) {
     std::error_code ec;
-    fs::create_directories(fs::path(o.out_dir) / "extremes", ec);
-    if (ec) throw SimError(o.out_dir + ": " + ec.message());
+    if (!fs::exists(o.out_dir, ec)) made_here.dir = o.out_dir;
+    try {
+      series = std::make_unique<report::OutputSet>(
+          (fs::path(o.out_dir) / "extremes").string());
+    } catch (const std::runtime_error& e) {
+      throw SimError(o.out_dir + ": " + e.what());
+    }
   }
   // the scenarios are independent: run them on `jobs` threads (each loop's
   // hand is registered for its own mjData, and model loading is
@@ -487,27 +506,39 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
   std::vector<std::string> errors(table.size());
   const auto start = std::chrono::steady_clock::now();
   std::atomic<std::size_t> finished{0};
+  std::atomic<bool> stopped{false};
   report::parallel_for(table.size(), o.jobs, [&](std::size_t i) {
+    // once stopped, the scenarios not begun are skipped
+    if (stopped || stop_asked(o.should_stop)) {
+      stopped = true;
+      return;
+    }
     std::vector<TickRecord> rows;
     try {
-      result.scenarios[i] = run_extreme(table[i], &rows);
+      result.scenarios[i] = run_extreme(table[i], &rows, o.should_stop);
       result.energy[i] = thin_energy(rows);
-      if (!o.out_dir.empty()) {
-        report::write_file_atomically(
-            (fs::path(o.out_dir) / "extremes" / (table[i].name + ".csv")).string(),
-            extreme_series_csv(rows));
-      }
+      if (series) series->write(table[i].name + ".csv", extreme_series_csv(rows));
+    } catch (const Interrupted&) {
+      stopped = true;
+      return;
     } catch (const std::exception& e) {
       errors[i] = table[i].name + ": " + e.what();
     }
     if (o.progress) o.progress(++finished, table.size());
   });
+  if (stopped) throw Interrupted();
   for (const std::string& e : errors) {
     if (!e.empty()) throw SimError(e);
   }
   result.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!o.out_dir.empty()) write_extremes_files(result, o.out_dir);
+  // the last poll: from here the series' folder and the three files go in
+  throw_if_stop_asked(o.should_stop);
+  if (series) {
+    made_here.keep = true;
+    series->commit();
+    write_extremes_files(result, o.out_dir);
+  }
   return result;
 }
 

@@ -26,6 +26,7 @@
 
 #include "report/svg_chart.h"
 #include "sim/closed_loop.h"
+#include "studies/stop.h"
 
 namespace vmh::studies {
 
@@ -163,9 +164,11 @@ struct ExtremeResult {
 };
 
 // Runs one scenario. With `trace` non-null, fills it with every tick's row.
-// Throws SimError on bad input (a bad override, an unreachable start pose).
+// Throws SimError on bad input (a bad override, an unreachable start pose),
+// Interrupted when `stop` (if set, polled every tick) says so.
 ExtremeResult run_extreme(const ExtremeScenario& s,
-                          std::vector<TickRecord>* trace = nullptr);
+                          std::vector<TickRecord>* trace = nullptr,
+                          const StopFn& stop = {});
 
 struct ExtremesOptions {
   std::vector<std::string> only;  // scenario names, in this order; empty: all
@@ -175,6 +178,9 @@ struct ExtremesOptions {
   // called from the workers with (scenarios done, scenarios); not set:
   // nothing
   std::function<void(std::size_t, std::size_t)> progress;
+  // polled from the workers between scenarios and every tick (studies/
+  // stop.h); not set: never stops
+  StopFn should_stop;
 };
 
 // The passivity observer E(t) of one scenario, thinned for the figure
@@ -196,7 +202,11 @@ struct ExtremesResult {
 // out_dir/extremes.json (extremes_json), out_dir/extremes.svg (the
 // observer's E(t), one panel per scenario) and out_dir/extremes/<name>.csv
 // (a time series per scenario). Throws SimError naming the scenario on bad
-// input.
+// input. The series go into a private folder beside out_dir/extremes as
+// they are made (report::OutputSet) and replace that folder whole at the
+// end, just before the three files: should_stop (polled last before that)
+// throws Interrupted with nothing written and no folder of its own left,
+// and out_dir/extremes then holds only the series of the scenarios run.
 ExtremesResult run_extremes_study(const ExtremesOptions& options);
 
 // ---------------------------------------------------------------- output

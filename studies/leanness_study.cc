@@ -102,7 +102,7 @@ void switch_on(ClosedLoop* loop, unsigned ingredients) {
   loop->reset();
 }
 
-void run_variant(VariantLoop* v, int ticks) {
+void run_variant(VariantLoop* v, int ticks, const StopFn& stop) {
   ClosedLoop& loop = *v->loop;
   const mjModel* m = loop.model();
   mjData* d = loop.data();
@@ -118,6 +118,8 @@ void run_variant(VariantLoop* v, int ticks) {
   const auto t0 = Clock::now();
   const double cpu0 = thread_cpu_s();
   for (std::size_t k = 0; k < n; ++k) {
+    // every 64 ticks: a poll per tick would be timed with the variant
+    if ((k & 63u) == 0) throw_if_stop_asked(stop);
     loop.tick(&row);
     if (v->viewer) v->viewer->update(m, d);
     v->p_mm[k] =
@@ -262,7 +264,8 @@ VariantResult variant_result(const VariantLoop& v, const VariantLoop& composed,
 
 // One case: its variants run `repeats` times, interleaved.
 CaseLeanness measure_case(const std::pair<std::string, std::string>& scene,
-                          std::vector<VariantLoop>* loops_in, int repeats) {
+                          std::vector<VariantLoop>* loops_in, int repeats,
+                          const StopFn& stop) {
   std::vector<VariantLoop>& loops = *loops_in;
   const ClosedLoop& first = *loops.front().loop;
   CaseLeanness cl;
@@ -280,7 +283,7 @@ CaseLeanness measure_case(const std::pair<std::string, std::string>& scene,
   for (int rep = 0; rep < repeats; ++rep) {
     for (std::size_t i = 0; i < loops.size(); ++i) {
       run_variant(&loops[(i + static_cast<std::size_t>(rep)) % loops.size()],
-                  cl.ticks);
+                  cl.ticks, stop);
     }
   }
   cl.controller_cpu_time_s = controller_cpu_s(loops.front(), repeats);
@@ -303,12 +306,18 @@ LeannessResult run_leanness_study(const LeannessOptions& o) {
   sets.push_back("duration_s=" + exact(o.duration_s));
   // every loop is built (and every scene checked) before the first run
   std::vector<std::vector<VariantLoop>> all;
-  for (const auto& scene : o.scenes) all.push_back(make_loops(scene.second, sets));
+  for (const auto& scene : o.scenes) {
+    throw_if_stop_asked(o.should_stop);
+    all.push_back(make_loops(scene.second, sets));
+  }
   for (std::size_t c = 0; c < o.scenes.size(); ++c) {
-    result.cases.push_back(measure_case(o.scenes[c], &all[c], result.repeats));
+    result.cases.push_back(
+        measure_case(o.scenes[c], &all[c], result.repeats, o.should_stop));
   }
   result.study_wall_time_s =
       std::chrono::duration<double>(Clock::now() - study_start).count();
+  // the last poll: from here leanness.csv goes in
+  throw_if_stop_asked(o.should_stop);
   if (!o.out_dir.empty()) {
     result.files = {report::write_file_in(o.out_dir, "leanness.csv",
                                           leanness_csv(result))};

@@ -35,6 +35,8 @@
 #include <utility>
 #include <vector>
 
+#include "studies/stop.h"
+
 namespace vmh::studies {
 
 // what a variant switches on (or, for kNoFrictionloss, off)
@@ -61,6 +63,10 @@ struct LeannessOptions {
   double duration_s = 2.0;  // simulated per variant and repeat
   int repeats = 5;
   std::string out_dir;  // where leanness.csv goes; empty: nothing written
+  // polled between the cases' loads, before each variant's run and every
+  // 64 of its ticks, and last before leanness.csv is written
+  // (studies/stop.h); not set: never stops
+  StopFn should_stop;
 };
 
 struct VariantResult {
@@ -121,7 +127,8 @@ struct LeannessResult {
 };
 
 // Runs the study and, with out_dir, writes out_dir/leanness.csv. Throws
-// SimError on a bad scene or override, before any run.
+// SimError on a bad scene or override, before any run; Interrupted when
+// should_stop says so, before anything is written.
 LeannessResult run_leanness_study(const LeannessOptions& options);
 
 // one row per case and variant, units in the column names

@@ -31,6 +31,7 @@
 #include "report/progress.h"
 #include "report/svg_chart.h"
 #include "studies/modelling_spread.h"
+#include "studies/stop.h"
 
 namespace vmh::studies {
 
@@ -68,6 +69,10 @@ struct PrecisionOptions {
   // called with (runs done, runs) after the references (one item) and after
   // each rung of the ladder; not set: nothing
   report::ProgressFn progress;
+  // polled between the runs and every 64 ticks of each (both references'
+  // threads too), and last before the files are written (studies/stop.h);
+  // not set: never stops
+  StopFn should_stop;
   // the sensitivity study's spread of the RMS path error, shown beside the
   // errors (precision.svg, the JSON's modelling_spread); not present: none
   ModellingSpread modelling_spread;
@@ -153,7 +158,8 @@ inline constexpr double kFloorFactor = 10.0;
 // Runs the study and, with out_dir, writes its files (write_precision_files).
 // Throws SimError on bad input (a step that does not divide the servo
 // period or is not above the reference step, a bad scene or override, a
-// duration beyond the case's), before any run.
+// duration beyond the case's), before any run; Interrupted when
+// should_stop says so, before any file is written.
 PrecisionResult run_precision_study(const PrecisionOptions& options);
 
 // The least-squares slope and intercept of log10(e) against log10(h).

@@ -21,6 +21,7 @@
 #include "sim/mujoco_messages.h"
 #include "sim/case_catalogue.h"
 #include "studies/claims.h"
+#include "studies/stop.h"
 
 namespace vmh::studies {
 
@@ -40,12 +41,8 @@ struct CaseResult {
   int kept_every = 1;
 };
 
-// Polled between ticks and before the outputs are written: true asks the
-// run to stop (a signal, cli/run.cc); the run then throws Interrupted.
-using StopFn = std::function<bool()>;
-struct Interrupted : std::runtime_error {
-  Interrupted() : std::runtime_error("interrupted") {}
-};
+// StopFn and Interrupted (studies/stop.h): polled between ticks and before
+// the outputs are written (a signal, cli/run.cc).
 
 // Throws SimError naming `dir`, the bytes needed and the bytes available
 // when a trace of `ticks` rows (runtime::trace_bytes_bound, and a tenth more for the

@@ -441,7 +441,8 @@ SweepPlan plan_sweep(const SensitivityOptions& options) {
   return plan;
 }
 
-PointResult run_point(const SweepPlan& plan, std::size_t index) {
+PointResult run_point(const SweepPlan& plan, std::size_t index,
+                      const StopFn& stop) {
   PointResult r;
   r.index = index;
   const SweepPoint& pt = plan.points.at(index);
@@ -468,6 +469,7 @@ PointResult run_point(const SweepPlan& plan, std::size_t index) {
     std::vector<TickRecord> rows;
     rows.reserve(static_cast<std::size_t>(loop.ticks_per_run()));
     while (!loop.finished()) {
+      throw_if_stop_asked(stop);
       rows.emplace_back();
       loop.tick(&rows.back());
     }
@@ -476,6 +478,8 @@ PointResult run_point(const SweepPlan& plan, std::size_t index) {
       r.claims.push_back({cl.name, cl.value, cl.threshold, cl.comparison,
                           cl.unit, static_cast<bool>(cl.pass)});
     }
+  } catch (const Interrupted&) {
+    throw;  // not the point's failure: the sweep stops
   } catch (const std::exception& e) {
     r.error = e.what();
     r.rms_path_error_mm = std::nan("");
@@ -487,18 +491,30 @@ PointResult run_point(const SweepPlan& plan, std::size_t index) {
 std::vector<PointResult> run_points(const SweepPlan& plan,
                                     const std::vector<std::size_t>& which,
                                     int jobs,
-                                    const report::ProgressFn& progress) {
+                                    const report::ProgressFn& progress,
+                                    const StopFn& stop) {
   std::vector<std::size_t> list = which;
   if (list.empty()) {
     for (std::size_t i = 0; i < plan.points.size(); ++i) list.push_back(i);
   }
   std::vector<PointResult> out(list.size());
   std::atomic<std::size_t> done{0};
+  std::atomic<bool> stopped{false};
   report::parallel_for(list.size(), jobs > 0 ? jobs : report::core_count(),
                        [&](std::size_t i) {
-                         out[i] = run_point(plan, list[i]);
+                         if (stopped || stop_asked(stop)) {
+                           stopped = true;
+                           return;
+                         }
+                         try {
+                           out[i] = run_point(plan, list[i], stop);
+                         } catch (const Interrupted&) {
+                           stopped = true;
+                           return;
+                         }
                          if (progress) progress(++done, list.size());
                        });
+  if (stopped) throw Interrupted();
   return out;
 }
 

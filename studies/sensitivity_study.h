@@ -36,6 +36,7 @@
 #include "report/progress.h"
 #include "report/svg_chart.h"
 #include "sim/mujoco_util.h"
+#include "studies/stop.h"
 
 namespace vmh::studies {
 
@@ -153,14 +154,20 @@ struct PointResult {
 };
 
 // Runs one point: the case's closed loop to its end, its claims and RMS
-// path error. Never throws: a failed run is recorded in `error`.
-PointResult run_point(const SweepPlan& plan, std::size_t index);
+// path error. A failed run is recorded in `error`; it throws only
+// Interrupted, when `stop` (if set, polled every tick) says so.
+PointResult run_point(const SweepPlan& plan, std::size_t index,
+                      const StopFn& stop = {});
 
 // Runs the points `which` (all: empty) on `jobs` threads, in index order.
+// `stop` (if set) is polled from the workers between points and every
+// tick: once it says so, no point starts, those running end at their next
+// tick, and Interrupted is thrown (nothing is written here either way).
 std::vector<PointResult> run_points(const SweepPlan& plan,
                                     const std::vector<std::size_t>& which,
                                     int jobs,
-                                    const report::ProgressFn& progress = {});
+                                    const report::ProgressFn& progress = {},
+                                    const StopFn& stop = {});
 
 // The claim's margin: value - threshold for ">=", threshold - value for
 // "<=" (>= 0 where it holds), over |threshold| when that is not 0.

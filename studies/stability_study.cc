@@ -387,10 +387,11 @@ WallRun SliderWall::run(double k_N_per_m, int ticks,
 }
 
 SimKcrit k_crit_simulated(SliderWall& wall, double k_guess_N_per_m,
-                          double rel_tol) {
+                          double rel_tol, const StopFn& stop) {
   SimKcrit r;
   WallRun at_lo, at_hi;  // the bracket's runs
   auto grows = [&](double k) {
+    throw_if_stop_asked(stop);
     const WallRun run = wall.run(k);
     r.history.push_back(run);
     ++r.runs;
@@ -441,7 +442,8 @@ SimKcrit k_crit_simulated(SliderWall& wall, double k_guess_N_per_m,
 }
 
 StabilityReport study_stability(const std::string& model_path,
-                                const StabilityParams& p, double rel_tol) {
+                                const StabilityParams& p, double rel_tol,
+                                const StopFn& stop) {
   const auto t0 = std::chrono::steady_clock::now();
   StabilityReport r;
   r.params = p;
@@ -453,7 +455,7 @@ StabilityReport study_stability(const std::string& model_path,
   // the exact discrete value only says where to start looking
   const double guess = r.exact.k_crit_N_per_m > 0.0 ? r.exact.k_crit_N_per_m
                                                     : r.k_bound_gil_N_per_m;
-  r.sim = k_crit_simulated(wall, guess, rel_tol);
+  r.sim = k_crit_simulated(wall, guess, rel_tol, stop);
   r.wall_time_s = std::chrono::duration<double>(
                       std::chrono::steady_clock::now() - t0)
                       .count();
@@ -481,7 +483,13 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
   }
   std::vector<std::exception_ptr> errors(points.size());
   std::atomic<std::size_t> finished{0};
+  std::atomic<bool> stopped{false};
   report::parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
+    // once stopped, the points not begun are skipped
+    if (stopped || stop_asked(spec.should_stop)) {
+      stopped = true;
+      return;
+    }
     try {
       const StabilityParams& p = params[i];
       MapPoint& pt = points[i];
@@ -495,12 +503,16 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
       const double guess = pt.k_crit_exact_N_per_m > 0.0
                                ? pt.k_crit_exact_N_per_m
                                : pt.k_bound_gil_N_per_m;
-      pt.sim = k_crit_simulated(wall, guess, spec.rel_tol);
+      pt.sim = k_crit_simulated(wall, guess, spec.rel_tol, spec.should_stop);
+    } catch (const Interrupted&) {
+      stopped = true;
+      return;
     } catch (...) {
       errors[i] = std::current_exception();
     }
     if (spec.progress) spec.progress(++finished, points.size());
   });
+  if (stopped) throw Interrupted();
   for (const std::exception_ptr& e : errors) {
     if (e) std::rethrow_exception(e);
   }
@@ -511,7 +523,7 @@ StabilityResult run_stability_study(const StabilityOptions& o) {
   StabilityResult r;
   r.options = o;
   if (!r.is_map()) {
-    r.bisection = study_stability(o.model_path, o.params, o.rel_tol);
+    r.bisection = study_stability(o.model_path, o.params, o.rel_tol, o.should_stop);
     SliderWall probe(o.model_path, o.params);
     r.horizon_ticks_at_k_crit = probe.horizon_ticks(r.bisection.sim.k_crit_N_per_m);
     r.wall_time_s = r.bisection.wall_time_s;
@@ -523,12 +535,15 @@ StabilityResult run_stability_study(const StabilityOptions& o) {
     spec.rel_tol = o.rel_tol;
     spec.jobs = o.jobs;
     spec.progress = o.progress;
+    spec.should_stop = o.should_stop;
     const auto t0 = std::chrono::steady_clock::now();
     r.map = stability_map(o.model_path, spec);
     r.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
             .count();
   }
+  // the last poll: from here the files go in
+  throw_if_stop_asked(o.should_stop);
   if (!o.out_dir.empty()) r.files = write_stability_files(r, o.out_dir);
   return r;
 }

@@ -62,6 +62,7 @@
 #include "report/progress.h"
 #include "report/svg_chart.h"
 #include "sim/mujoco_util.h"
+#include "studies/stop.h"
 
 namespace vmh::studies {
 
@@ -217,9 +218,10 @@ struct SimKcrit {
 // `k_guess_N_per_m` (K_guess x 1.03^-1 and x 1.03, widened geometrically
 // until one run decays and the other grows), then bisected until
 // (K_unstable - K_stable) / K_stable <= rel_tol. The guess only says where
-// to look; every K is judged by a run.
+// to look; every K is judged by a run. `stop` (if set) is polled before
+// each run: Interrupted once it says so.
 SimKcrit k_crit_simulated(SliderWall& wall, double k_guess_N_per_m,
-                          double rel_tol = 2e-3);
+                          double rel_tol = 2e-3, const StopFn& stop = {});
 
 // The whole comparison for one setting.
 struct StabilityReport {
@@ -234,7 +236,8 @@ struct StabilityReport {
 
 StabilityReport study_stability(const std::string& model_path,
                                 const StabilityParams& p,
-                                double rel_tol = 2e-3);
+                                double rel_tol = 2e-3,
+                                const StopFn& stop = {});
 
 // ---------------------------------------------------------------- map
 
@@ -248,6 +251,9 @@ struct MapSpec {
   int jobs = 1;  // threads, each with its own model and data
   // called from the workers with (points done, points); not set: nothing
   report::ProgressFn progress;
+  // polled from the workers before each point and each run of its
+  // bisection; once it says so no point starts and Interrupted is thrown
+  StopFn should_stop;
 };
 
 struct MapPoint {
@@ -278,6 +284,9 @@ struct StabilityOptions {
   std::vector<int> map_delay_ticks;
   int jobs = 1;  // map points simulated at once
   report::ProgressFn progress;  // the map's (MapSpec::progress)
+  // polled before each run of a bisection (each point's, for a map) and
+  // last before the files are written: Interrupted, nothing written
+  StopFn should_stop;
   // where the CSV and the chart go (write_stability_files); empty: nothing
   std::string out_dir;
 };
