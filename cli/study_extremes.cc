@@ -8,7 +8,9 @@
 // DIR/extremes.csv, DIR/extremes.json, DIR/extremes.svg and
 // DIR/extremes/<scenario>.csv.
 // Exit codes: 0 every scenario ended finite and bounded with its expected
-// status; 1 one did not; 2 bad usage.
+// status; 1 one did not; 2 bad usage; 130 / 143 stopped by SIGINT / SIGTERM
+// (--out as it was, or its files all written if the signal came as they
+// went in).
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
@@ -18,8 +20,11 @@
 
 #include "cli/args.h"
 #include "cli/study.h"
-#include "studies/extremes_study.h"
+#include "cli/study_files.h"
+#include "device/stop_signal.h"
 #include "report/parallel.h"
+#include "report/progress.h"
+#include "studies/extremes_study.h"
 
 namespace vmh::cli {
 namespace {
@@ -54,6 +59,9 @@ void print_table(const std::vector<studies::ExtremeResult>& results) {
 }
 
 void run(const ExtremesCli& o) {
+  // SIGINT / SIGTERM only set a flag for the whole run, which the study
+  // polls (cli/study_files.h): exit 130 / 143, --out as it was
+  StopSignals signals;
   // -5 ran on every core as if 0 had been given (issue 17)
   if (o.jobs < 0) {
     throw UsageError("--jobs: must be >= 0 (0: one per core), got " +
@@ -63,12 +71,20 @@ void run(const ExtremesCli& o) {
   p.only = o.only;
   p.out_dir = o.out;
   p.jobs = o.jobs > 0 ? o.jobs : report::core_count();
+  p.should_stop = study_stop();
   studies::ExtremesResult r;
   try {
-    r = studies::run_extremes_study(p);
+    // the bar (on a terminal) is finished before the JSON or the table
+    report::Progress bar("study extremes",
+                         o.only.empty() ? studies::extreme_scenarios().size()
+                                        : o.only.size());
+    p.progress = bar.part(0);
+    r = run_stoppable("study extremes",
+                      [&] { return studies::run_extremes_study(p); });
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study extremes: ") + e.what());
   }
+  throw_if_stopped_after_writing("study extremes", o.out);
   if (o.table) {
     print_table(r.scenarios);
   } else {

@@ -1,6 +1,7 @@
 #include "cli/study_files.h"
 
 #include "cli/args.h"
+#include "device/stop_signal.h"
 #include "sim/mujoco_util.h"
 #include "studies/run_case.h"
 
@@ -33,6 +34,17 @@ std::vector<double> parse_number_list(const std::string& option,
     ++item;
   }
   return out;
+}
+
+studies::StopFn study_stop() {
+  return [] { return stop_requested(); };
+}
+
+void throw_if_stopped_after_writing(const std::string& verb,
+                                    const std::string& out) {
+  runtime::throw_if_stopped(
+      verb, out.empty() ? "; nothing written"
+                        : "; its files in " + out + " were already written whole");
 }
 
 }  // namespace vmh::cli

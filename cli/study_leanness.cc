@@ -4,7 +4,9 @@
 // Steps per second of each case's scene as composed against the same scene
 // with contacts, gravity and a viewer's scene update switched on, each alone
 // and all together (studies/leanness_study.h). Prints one JSON object; with
-// --out writes DIR/leanness.csv. Exit 2 on bad usage, naming the option.
+// --out writes DIR/leanness.csv. Exit 2 on bad usage, naming the option;
+// 130 / 143 stopped by SIGINT / SIGTERM (--out as it was, or leanness.csv
+// written whole if the signal came as it went in).
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -13,6 +15,7 @@
 #include "runtime/json_util.h"
 #include "cli/study.h"
 #include "cli/study_files.h"
+#include "device/stop_signal.h"
 #include "studies/leanness_study.h"
 #include "sim/mujoco_util.h"
 #include "studies/run_case.h"
@@ -29,6 +32,9 @@ struct LeannessCli {
 };
 
 void run(const LeannessCli& o) {
+  // SIGINT / SIGTERM only set a flag for the whole run, which the study
+  // polls (cli/study_files.h): exit 130 / 143, --out as it was
+  StopSignals signals;
   studies::LeannessOptions p;
   if (o.cases.empty()) {
     for (const sim::CaseEntry& c : sim::thesis_cases()) {
@@ -62,13 +68,16 @@ void run(const LeannessCli& o) {
   p.overrides = o.sets;
 
   p.out_dir = o.out;
+  p.should_stop = study_stop();
 
   studies::LeannessResult r;
   try {
-    r = studies::run_leanness_study(p);
+    r = run_stoppable("study leanness",
+                      [&] { return studies::run_leanness_study(p); });
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study leanness: ") + e.what());
   }
+  throw_if_stopped_after_writing("study leanness", o.out);
   std::cout << dump_readable(studies::leanness_json(r)) << '\n';
 }
 

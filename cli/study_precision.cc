@@ -8,7 +8,9 @@
 // and physics step (studies/precision_study.h). Prints one JSON object; with
 // --out writes DIR/precision.csv, DIR/precision.svg (error vs wall time) and
 // DIR/precision_order.svg (error vs h). Exit 2 on bad usage, naming the
-// option; nothing is written then. With --modelling-spread, the sensitivity
+// option; nothing is written then. SIGINT / SIGTERM exit 130 / 143, --out
+// as it was (or its files all written if the signal came as they went
+// in). With --modelling-spread, the sensitivity
 // study's spread of the RMS path error for the same case is drawn across
 // precision.svg and compared with the default setting's error in the JSON.
 #include <cmath>
@@ -20,6 +22,7 @@
 #include "runtime/json_util.h"
 #include "cli/study.h"
 #include "cli/study_files.h"
+#include "device/stop_signal.h"
 #include "report/progress.h"
 #include "sim/case.h"
 #include "sim/mujoco_util.h"
@@ -156,6 +159,9 @@ void check_against_case(const studies::PrecisionOptions& p) {
 }
 
 void run(const PrecisionCli& o) {
+  // SIGINT / SIGTERM only set a flag for the whole run, which the study
+  // polls (cli/study_files.h): exit 130 / 143, --out as it was
+  StopSignals signals;
   const studies::PrecisionOptions p = to_options(o);
   check_against_case(p);
   studies::PrecisionResult r;
@@ -163,10 +169,13 @@ void run(const PrecisionCli& o) {
     report::Progress bar("study precision", 0);
     studies::PrecisionOptions with_bar = p;
     with_bar.progress = bar.part(0);
-    r = studies::run_precision_study(with_bar);
+    with_bar.should_stop = study_stop();
+    r = run_stoppable("study precision",
+                      [&] { return studies::run_precision_study(with_bar); });
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study precision: ") + e.what());
   }
+  throw_if_stopped_after_writing("study precision", o.out);
   std::cout << dump_readable(studies::precision_json(r)) << '\n';
 }
 

@@ -11,7 +11,10 @@
 // i mod N == K - 1 and writes DIR/sensitivity.partial.json; `study merge`
 // joins the N partial files into the files one run writes.
 // Exit codes: 0 done (claims that fail are results, not errors); 2 bad
-// usage or input, nothing written; 1 anything else.
+// usage or input, nothing written; 1 anything else; 130 / 143 stopped by
+// SIGINT / SIGTERM (polled between points, every tick and before the files
+// go in: --out as it was, or its files all written if the signal came as
+// they went in).
 #include <unistd.h>
 
 #include <filesystem>
@@ -24,6 +27,7 @@
 #include "runtime/json_util.h"
 #include "cli/study.h"
 #include "cli/study_files.h"
+#include "device/stop_signal.h"
 #include "report/parallel.h"
 #include "report/progress.h"
 #include "sim/mujoco_util.h"
@@ -141,6 +145,9 @@ Json summary(const nlohmann::ordered_json& full,
 }
 
 void run(const SensitivityCli& o) {
+  // SIGINT / SIGTERM only set a flag for the whole run, which the sweep
+  // polls (cli/study_files.h): exit 130 / 143, --out as it was
+  StopSignals signals;
   int k = 0, n = 0;
   if (!o.shard.empty() && !studies::parse_shard(o.shard, &k, &n)) {
     throw UsageError("--shard: '" + o.shard + "' is not K/N with 1 <= K <= N");
@@ -174,11 +181,17 @@ void run(const SensitivityCli& o) {
   std::vector<studies::PointResult> results;
   {
     report::Progress bar("study sensitivity", count);
-    results = studies::run_points(plan, which, o.jobs > 0 ? o.jobs : report::core_count(),
-                                  bar.part(0));
+    results = run_stoppable("study sensitivity", [&] {
+      return studies::run_points(plan, which,
+                                 o.jobs > 0 ? o.jobs : report::core_count(),
+                                 bar.part(0), study_stop());
+    });
   }
+  // the last poll: from here the files go in
+  runtime::throw_if_stopped("study sensitivity", "; nothing written");
   if (n > 0) {
     const std::string path = studies::write_partial_file(plan, k, n, results, o.out);
+    throw_if_stopped_after_writing("study sensitivity", o.out);
     std::cout << dump_readable(Json{{"study", "sensitivity"},
                                     {"sweep_id", plan.id},
                                     {"shard", {{"k", k}, {"n", n}}},
@@ -189,11 +202,15 @@ void run(const SensitivityCli& o) {
     return;
   }
   const auto files = studies::write_sensitivity_files(plan, results, o.out);
+  throw_if_stopped_after_writing("study sensitivity", o.out);
   std::cout << dump_readable(summary(studies::sensitivity_json(plan, results), files))
             << '\n';
 }
 
 void merge(const MergeCli& o) {
+  // SIGINT / SIGTERM only set a flag for the whole run: polled before the
+  // files go in and after (exit 130 / 143)
+  StopSignals signals;
   if (o.parts.empty()) throw UsageError("study merge: give the shards' folders or files");
   check_out(o.out);
   studies::Merged m;
@@ -202,7 +219,9 @@ void merge(const MergeCli& o) {
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study merge: ") + e.what());
   }
+  runtime::throw_if_stopped("study merge", "; nothing written");
   const auto files = studies::write_sensitivity_files(m.plan, m.results, o.out);
+  throw_if_stopped_after_writing("study merge", o.out);
   std::cout << dump_readable(summary(studies::sensitivity_json(m.plan, m.results), files))
             << '\n';
 }

@@ -13,7 +13,10 @@
 // bisection) and DIR/stability_bisection.svg (their growth rates against K
 // with the theories' K marked); with --map: DIR/stability_map.csv and
 // DIR/stability_map.svg, K_crit against B for each delay.
-// Exit codes: 0 done; 2 bad usage or input; 1 anything else.
+// Exit codes: 0 done; 2 bad usage or input; 1 anything else; 130 / 143
+// stopped by SIGINT / SIGTERM (polled before each run of a bisection and
+// before the files go in: --out as it was, or its files all written if the
+// signal came as they went in).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -26,6 +29,9 @@
 #include "cli/args.h"
 #include "runtime/json_util.h"
 #include "cli/study.h"
+#include "cli/study_files.h"
+#include "device/stop_signal.h"
+#include "report/output_file.h"
 #include "report/parallel.h"
 #include "report/progress.h"
 #include "studies/run_case.h"
@@ -64,11 +70,14 @@ constexpr int kDefaultStepsPerTick = 1000;
 // the points
 constexpr double kDefaultMapBMaxTimesMOverT = 0.1;
 
+// --out checked before the study (created and removed again: a study
+// stopped by a signal leaves no folder of its own; the writers create it)
 void make_out_dir(const std::string& out) {
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec || !fs::is_directory(out)) {
-    throw UsageError("--out: cannot create directory '" + out + "'");
+  try {
+    report::check_writable_dir(out);
+  } catch (const std::runtime_error& e) {
+    throw UsageError("--out: cannot create directory '" + out + "' (" +
+                     e.what() + ")");
   }
 }
 
@@ -106,12 +115,16 @@ std::string number_text(double v) {
 void run_study(const studies::StabilityOptions& p,
                report::Progress* bar = nullptr) {
   studies::StabilityResult r;
+  studies::StabilityOptions stoppable = p;
+  stoppable.should_stop = study_stop();
   try {
-    r = studies::run_stability_study(p);
+    r = run_stoppable("study stability",
+                      [&] { return studies::run_stability_study(stoppable); });
   } catch (const sim::SimError& e) {
     throw UsageError(e.what());
   }
   if (bar != nullptr) bar->finish();
+  throw_if_stopped_after_writing("study stability", p.out_dir);
   std::cout << dump_readable(studies::stability_json(r)) << '\n';
 }
 
@@ -172,6 +185,9 @@ void run_map(const StabilityCli& o, const studies::StabilityParams& base) {
 }
 
 void run(const StabilityCli& o) {
+  // SIGINT / SIGTERM only set a flag for the whole run, which the study
+  // polls (cli/study_files.h): exit 130 / 143, --out as it was
+  StopSignals signals;
   if (!(o.tolerance >= 1e-5 && o.tolerance <= 0.1)) {
     throw UsageError("--tolerance: the relative bracket width must be in "
                      "[1e-5, 0.1] (got " + number_text(o.tolerance) + ")");

@@ -2,7 +2,9 @@
 // cli/main.cc, which exits 128 + its number (130, 143) with its message.
 //
 // The verbs whose work is long outside a device session (compare,
-// identify, report, render, hw run's judging) hold a StopSignals
+// identify, report, render, hw run's judging, the study sub-verbs, whose
+// studies poll a studies::StopFn and throw studies::Interrupted, which
+// cli/study_files.h turns into SignalStop) hold a StopSignals
 // (device/stop_signal.h) for their whole run and call throw_if_stopped()
 // between the steps of their long loops and before each commit of their
 // outputs: a signal then leaves the previous output sets as they were, or
