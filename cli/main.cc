@@ -67,7 +67,7 @@ void check_verbs(CLI::App* app, int argc, char** argv) {
   std::string path = "vmhaptics";
   for (int i = 1; i < argc && argv[i][0] != '-'; ++i) {
     const auto subs = app->get_subcommands([](CLI::App*) { return true; });
-    if (subs.empty()) return;
+    if (subs.empty()) break;  // the verb's own positional arguments
     CLI::App* next = nullptr;
     std::string names;
     for (CLI::App* s : subs) {

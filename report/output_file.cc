@@ -214,7 +214,8 @@ OutputSet::OutputSet(const std::string& dest) : dest_(dest) {
                                  "-XXXXXX"))
                           .string();
   if (mkdtemp(templ.data()) == nullptr) {
-    throw std::runtime_error(parent.string() + ": " + os_error(errno));
+    throw std::runtime_error(parent.string() + ": cannot make a folder in it (" +
+                             os_error(errno) + ")");
   }
   // mkdtemp makes it 0700; the set's folder gets a folder's usual mode
   const mode_t mask = 022;

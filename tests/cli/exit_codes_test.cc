@@ -106,7 +106,12 @@ const std::map<std::string, Row>& rows() {
       {"study sensitivity", {{{"--shard 3/2", "'3/2' is not K/N"}}, "", ""}},
       {"study merge", {{{"--out OUT /nonexistent", "/nonexistent: cannot read"}}, "", ""}},
       {"compare", {{{"/nonexistent", "/nonexistent/meta.json: no such file"}}, "", ""}},
-      {"identify", {{{"/nonexistent", "/nonexistent is not a directory"}}, "", ""}},
+      {"identify",
+       {{{"/nonexistent", "/nonexistent is not a directory"},
+         // an option after a positional argument is still named
+         {"/nonexistent --scene x", "has no option --scene"}},
+        "",
+        ""}},
       {"report", {{{"--out /proc/vmh_no/x", "/proc/vmh_no/x"}}, "", ""}},
       {"render",
        {{{"case1 --t 1e6 --out OUT", "--t: time 1e+06 s is past the scene's duration_s"}},
