@@ -37,6 +37,7 @@
 #include "studies/precision_study.h"
 #include "studies/report_html.h"
 #include "studies/run_case.h"
+#include "studies/stop.h"
 #include "studies/stability_study.h"
 #ifdef VMH_HAVE_VIZ
 #include "sim/case.h"
@@ -184,6 +185,19 @@ std::string map_note(const studies::StabilityOptions& so) {
   return s.str();
 }
 
+// One of the studies, asked to stop when a signal came (it polls the
+// flag inside its runs and throws Interrupted before writing): the stop
+// named as report's, with what report keeps
+template <typename F>
+void run_stoppable(F study, const std::string& kept) {
+  try {
+    study();
+  } catch (const studies::Interrupted&) {
+    runtime::throw_if_stopped("report", kept);
+    throw;
+  }
+}
+
 void run(const ReportCli& o) {
   if (o.jobs < 0) throw UsageError("--jobs: must be >= 1 (0: one per core)");
   if (o.out.empty()) throw UsageError("--out: give a directory");
@@ -251,20 +265,23 @@ void run(const ReportCli& o) {
       ex.out_dir = study_dir.string();
       ex.jobs = jobs;
       ex.progress = bar.part(p_ex);
-      studies::run_extremes_study(ex);
+      ex.should_stop = [] { return stop_requested(); };
+      run_stoppable([&] { studies::run_extremes_study(ex); }, kept);
     }
     runtime::throw_if_stopped("report", kept);
     if (run_map) {
       studies::StabilityOptions m = map;
       m.progress = bar.part(p_map);
-      studies::run_stability_study(m);
+      m.should_stop = [] { return stop_requested(); };
+      run_stoppable([&] { studies::run_stability_study(m); }, kept);
     }
     runtime::throw_if_stopped("report", kept);
     if (run_precision) {
       // alone, so that its timings do not compete with other runs
       studies::PrecisionOptions p = precision;
       p.progress = bar.part(p_prec);
-      studies::run_precision_study(p);
+      p.should_stop = [] { return stop_requested(); };
+      run_stoppable([&] { studies::run_precision_study(p); }, kept);
     }
   }
 
