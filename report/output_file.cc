@@ -203,8 +203,20 @@ void check_writable_dir(const std::string& dir) {
   unmake();
 }
 
-OutputSet::OutputSet(const std::string& dest) : dest_(dest) {
-  const fs::path d(dest);
+OutputSet::OutputSet(const std::string& dest) {
+  // "out/", "./out" and "out" name one folder; ".", ".." and "/" name no
+  // folder a set could replace whole (the current one, a parent, the root)
+  fs::path d = fs::path(dest).lexically_normal();
+  if (!d.has_filename() && d.has_parent_path() && d.parent_path() != d) {
+    d = d.parent_path();
+  }
+  const std::string name = d.filename().string();
+  if (name.empty() || name == "." || name == "..") {
+    throw std::runtime_error("'" + dest + "' names no folder of its own (the current "
+                             "folder, a parent or the root): a set replaces its "
+                             "folder whole, so give it a folder's name");
+  }
+  dest_ = d.string();
   const fs::path parent = d.has_parent_path() ? d.parent_path() : fs::path(".");
   std::error_code ec;
   fs::create_directories(parent, ec);

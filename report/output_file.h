@@ -75,8 +75,11 @@ void check_writable_dir(const std::string& dir);
 // removes the temporary folder and `dest` is left as it was.
 class OutputSet {
  public:
-  // Creates dest's parent if needed and the temporary folder. Throws
-  // std::runtime_error naming the folder and the OS error.
+  // Creates dest's parent if needed and the temporary folder. `dest` is
+  // taken as its lexically normal form without a trailing '/' ("out/" and
+  // "./out" are "out"). Throws std::runtime_error naming the folder and the
+  // OS error, or for a dest that names no folder of its own (".", "..",
+  // "/", "a/.."): a set would replace the current folder or a parent.
   explicit OutputSet(const std::string& dest);
   ~OutputSet();  // removes the temporary folder unless committed
   OutputSet(const OutputSet&) = delete;

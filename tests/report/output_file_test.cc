@@ -114,6 +114,36 @@ TEST(OutputSet, FirstSetIsRenamedIntoPlace) {
   EXPECT_EQ(slurp(d / "case1" / "a.txt"), "A");
 }
 
+// "out/" and "./out" name the folder "out" (a trailing '/' made the set
+// rename itself into its own temporary folder: EINVAL); ".", ".." and "/"
+// name no folder a set may replace whole, and are refused unwritten
+TEST(OutputSet, ATrailingSlashIsTheSameFolderAndDotIsRefused) {
+  const fs::path d = fresh("slash");
+  {
+    OutputSet set((d / "out").string() + "/");
+    set.write("a.txt", "A");
+    set.commit();
+  }
+  EXPECT_EQ(names(d), std::set<std::string>({"out"}));
+  EXPECT_EQ(slurp(d / "out" / "a.txt"), "A");
+  {
+    OutputSet set((d / "." / "out" / "x" / "..").string() + "//");
+    set.write("b.txt", "B");
+    set.commit();
+  }
+  EXPECT_EQ(names(d / "out"), std::set<std::string>({"b.txt"}));
+  for (const std::string bad : {".", "..", "/", "./", "a/..", "../x/../.."}) {
+    try {
+      OutputSet set(bad);
+      ADD_FAILURE() << "'" << bad << "' was taken as a set's folder";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("names no folder of its own"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_EQ(names(d), std::set<std::string>({"out"}));
+}
+
 TEST(OutputSet, ASecondSetReplacesTheFirstWhole) {
   const fs::path d = fresh("second");
   {
