@@ -9,6 +9,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "report/output_file.h"
+
 #include "report/svg_text.h"
 #include "studies/force_field_svg.h"
 #include "studies/thesis_svg.h"
@@ -415,11 +417,12 @@ ReportCase load_report_case(const std::string& dir, const std::string& name,
 }
 
 std::string read_file_text(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return "";
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
+  // what --reuse reads is a file of an earlier run: a regular file, read
+  // without blocking and within a bound (a FIFO or /dev/zero in its place
+  // is refused, not waited on or read for ever)
+  bool missing = false;
+  std::string text = report::read_regular_file(path, kMaxReusedFileBytes, &missing);
+  return missing ? std::string() : text;
 }
 
 ClaimTally tally_claims(const std::vector<ReportCase>& cases) {

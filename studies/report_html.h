@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -70,7 +71,10 @@ struct ReportInputs {
 ReportCase load_report_case(const std::string& dir, const std::string& name,
                             const RenderFn& render);
 
-// a whole file's bytes; "" if it cannot be read
+// A whole file's bytes, "" when there is no file. Only a regular file of
+// at most kMaxReusedFileBytes is read (opened without blocking): anything
+// else throws std::runtime_error naming it (a FIFO, a device, its size).
+inline constexpr std::uint64_t kMaxReusedFileBytes = std::uint64_t{1} << 30;
 std::string read_file_text(const std::string& path);
 
 // claims over every case's summary.json

@@ -6,6 +6,7 @@
 #include "studies/report_html.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <atomic>
 #include <filesystem>
@@ -361,4 +362,26 @@ TEST(ReportHtmlTest, APartialClaimNamesItsFailingSide) {
 }
 
 }  // namespace
+// What --reuse reads is read as untrusted input: a FIFO in a file's place
+// is refused by its type (reading it would wait for a writer for ever),
+// a device is refused before it is read; a missing file is "".
+TEST(ReportReuse, OnlyRegularFilesAreRead) {
+  const std::string dir = ::testing::TempDir() + "vmh_report_reuse";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  EXPECT_EQ(read_file_text(dir + "/none.svg"), "");
+  const std::string fifo = dir + "/views.svg";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    (void)read_file_text(fifo);
+    ADD_FAILURE() << "a FIFO was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("views.svg is a FIFO"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(fifo);
+  std::filesystem::create_symlink("/dev/zero", fifo);
+  EXPECT_THROW((void)read_file_text(fifo), std::runtime_error);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace vmh::studies
