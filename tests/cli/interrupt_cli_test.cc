@@ -28,6 +28,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using vmh::testing::first_line;
 using vmh::testing::run;
+using vmh::testing::spawn_cli;
 
 fs::path intr_dir(const std::string& name) {
   return vmh::testing::fresh_dir("vmh_interrupt_cli_", name);
@@ -40,22 +41,6 @@ std::string intr_read(const fs::path& p) {
   return ss.str();
 }
 
-// `vmhaptics <args>` in a child, stdout to /dev/null, stderr to `err`
-pid_t intr_spawn(const std::vector<std::string>& args, const fs::path& err) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fd = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) dup2(fd, 2);
-    const int null = open("/dev/null", O_WRONLY);
-    if (null >= 0) dup2(null, 1);
-    std::vector<char*> argv = {const_cast<char*>(VMH_CLI_PATH)};
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(VMH_CLI_PATH, argv.data());
-    _exit(127);
-  }
-  return pid;
-}
 
 // the private folders beside `out` (".<name>.tmp-...", ".<name>.render-...")
 std::vector<fs::path> intr_private_folders(const fs::path& out) {
@@ -189,8 +174,8 @@ TEST(CompareOut, TwoAtOnceBothFinishAndLeaveOneWholeSet) {
   const fs::path base = intr_dir("concurrent");
   const fs::path out = base / "cmp";
   const fs::path err_a = base.string() + "_a.txt", err_b = base.string() + "_b.txt";
-  const pid_t a = intr_spawn({"compare", intr_tour().string(), "--out", out.string()}, err_a);
-  const pid_t b = intr_spawn({"compare", intr_tour().string(), "--out", out.string()}, err_b);
+  const pid_t a = spawn_cli({"compare", intr_tour().string(), "--out", out.string()}, err_a);
+  const pid_t b = spawn_cli({"compare", intr_tour().string(), "--out", out.string()}, err_b);
   ASSERT_GT(a, 0);
   ASSERT_GT(b, 0);
   const int code_a = intr_exit_code(a), code_b = intr_exit_code(b);
@@ -215,7 +200,7 @@ TEST(CompareOut, ASignalLeavesThePreviousSetOrAWholeNewOne) {
   for (const int signo : {SIGINT, SIGTERM}) {
     const std::string name = signo == SIGINT ? "SIGINT" : "SIGTERM";
     const fs::path err = base.string() + "_" + name + ".txt";
-    const pid_t pid = intr_spawn(args, err);
+    const pid_t pid = spawn_cli(args, err);
     ASSERT_GT(pid, 0);
     ASSERT_TRUE(intr_wait_for_private_folder(out, pid)) << first_line(err);
     ASSERT_EQ(kill(pid, signo), 0);
@@ -241,7 +226,7 @@ TEST(CompareOut, TheFirstOfSeveralSignalsWins) {
   for (int i = 0; i < 4; ++i) args.push_back(intr_tour().string());
   args.push_back("--out");
   args.push_back(out.string());
-  const pid_t pid = intr_spawn(args, err);
+  const pid_t pid = spawn_cli(args, err);
   ASSERT_GT(pid, 0);
   ASSERT_TRUE(intr_wait_for_private_folder(out, pid)) << first_line(err);
   kill(pid, SIGINT);
@@ -263,7 +248,7 @@ TEST(HwRunInterrupt, ASignalLeavesNothingOrTheWholeSet) {
   const fs::path out = base / "run";
   const fs::path err = base.string() + "_err.txt";
   fs::create_directories(base);
-  const pid_t pid = intr_spawn({"hw", "run", "case1", "--device", "emulator", "--clock",
+  const pid_t pid = spawn_cli({"hw", "run", "case1", "--device", "emulator", "--clock",
                                 "lockstep", "--quiet", "--out", out.string()},
                                err);
   ASSERT_GT(pid, 0);
@@ -286,7 +271,7 @@ TEST(HwRunInterrupt, ASignalLeavesNothingOrTheWholeSet) {
 TEST(ReportInterrupt, ASignalLeavesWholeSetsAndNoPage) {
   const fs::path out = intr_dir("report");
   const fs::path err = out.string() + "_err.txt";
-  const pid_t pid = intr_spawn({"report", "--quick", "--jobs", "1", "--out", out.string()},
+  const pid_t pid = spawn_cli({"report", "--quick", "--jobs", "1", "--out", out.string()},
                                err);
   ASSERT_GT(pid, 0);
   // the first case's private folder, inside --out

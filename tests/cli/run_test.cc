@@ -27,6 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 using vmh::testing::first_line;
 using vmh::testing::run;
+using vmh::testing::spawn_cli;
 
 fs::path fresh_dir(const std::string& name) {
   return vmh::testing::fresh_dir("vmh_run_", name);
@@ -400,22 +401,6 @@ TEST(RunCli, AFailedWriteLeavesThePreviousSet) {
   EXPECT_EQ(sets.at("case1").at("metrics").at("ticks"), 50);
 }
 
-// `vmhaptics run <args>` in a child process, its stderr into `err`
-pid_t spawn(const std::vector<std::string>& args, const fs::path& err) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fd = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) dup2(fd, 2);
-    const int null = open("/dev/null", O_WRONLY);
-    if (null >= 0) dup2(null, 1);
-    std::vector<char*> argv = {const_cast<char*>(VMH_CLI_PATH)};
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(VMH_CLI_PATH, argv.data());
-    _exit(127);
-  }
-  return pid;
-}
 
 // SIGTERM or SIGINT during `run --all`: exit 143 / 130 soon after, one line
 // "interrupted: ...", and the out folder holds complete sets only (most
@@ -425,7 +410,7 @@ TEST(RunCli, ASignalLeavesOnlyCompleteSets) {
     const std::string tag = signo == SIGTERM ? "sigterm" : "sigint";
     const fs::path out = fresh_dir(tag);
     const fs::path err = fresh_dir(tag + "_stderr.txt");
-    const pid_t pid = spawn({"run", "--all", "--out", out.string()}, err);
+    const pid_t pid = spawn_cli({"run", "--all", "--out", out.string()}, err);
     ASSERT_GT(pid, 0);
     usleep(300000);
     const auto sent = std::chrono::steady_clock::now();
@@ -456,7 +441,7 @@ TEST(RunCli, ASignalKeepsTheSetsAlreadyComplete) {
   // one case at a time, each of 5 simulated s (about a second of wall time
   // with its mirrored and near-path runs): stopped as soon as case1's set
   // is in place, while case2 runs
-  const pid_t pid = spawn({"run", "--all", "--jobs", "1", "--duration", "5",
+  const pid_t pid = spawn_cli({"run", "--all", "--jobs", "1", "--duration", "5",
                            "--out", out.string()},
                           err);
   ASSERT_GT(pid, 0);

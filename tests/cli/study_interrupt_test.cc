@@ -63,19 +63,7 @@ StiChild sti_spawn(const std::vector<std::string>& args) {
   if (c.master < 0 || grantpt(c.master) != 0 || unlockpt(c.master) != 0) return c;
   const char* slave_name = ptsname(c.master);
   if (slave_name == nullptr) return c;
-  const std::string slave(slave_name);
-  c.pid = fork();
-  if (c.pid == 0) {
-    const int fd = open(slave.c_str(), O_WRONLY | O_NOCTTY);
-    if (fd >= 0) dup2(fd, 2);
-    const int null = open("/dev/null", O_WRONLY);
-    if (null >= 0) dup2(null, 1);
-    std::vector<char*> argv = {const_cast<char*>(VMH_CLI_PATH)};
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(VMH_CLI_PATH, argv.data());
-    _exit(127);
-  }
+  c.pid = vmh::testing::spawn_cli(args, slave_name);
   return c;
 }
 

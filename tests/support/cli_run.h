@@ -3,6 +3,7 @@
 #ifndef VMHAPTICS_TESTS_SUPPORT_CLI_RUN_H_
 #define VMHAPTICS_TESTS_SUPPORT_CLI_RUN_H_
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,6 +14,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace vmh::testing {
 
@@ -46,6 +48,27 @@ inline CliRun run(const std::string& args, const std::string& env = "") {
   r.err = ss.str();
   std::remove(err_path.c_str());
   return r;
+}
+
+// starts `vmhaptics <args>` in a child process, its stdout to /dev/null and
+// its stderr to `stderr_path` (a file, created or emptied, or a terminal's
+// device such as a pty's slave); returns the child's pid for the caller to
+// signal and wait on
+inline pid_t spawn_cli(const std::vector<std::string>& args,
+                       const std::string& stderr_path) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = open(stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOCTTY, 0644);
+    if (fd >= 0) dup2(fd, 2);
+    const int null = open("/dev/null", O_WRONLY);
+    if (null >= 0) dup2(null, 1);
+    std::vector<char*> argv = {const_cast<char*>(VMH_CLI_PATH)};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(VMH_CLI_PATH, argv.data());
+    _exit(127);
+  }
+  return pid;
 }
 
 // an empty path under the test temp directory, named `prefix` + `name`
