@@ -3,9 +3,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
 
 #include "report/output_file.h"
-#include "runtime/recording_reader.h"
 
 namespace vmh::runtime {
 namespace {
@@ -161,8 +161,8 @@ std::optional<StoredCalibration> load_calibration(const std::string& serial) {
   bool missing = false;
   std::string text;
   try {
-    text = read_regular_file(path, kMaxFileBytes, &missing);
-  } catch (const RecordingError& e) {
+    text = report::read_regular_file(path, kMaxFileBytes, &missing);
+  } catch (const std::runtime_error& e) {
     throw CalibrationError(std::string(e.what()) + " (not a calibration)");
   }
   if (missing) return std::nullopt;

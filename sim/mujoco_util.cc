@@ -7,7 +7,6 @@
 #include <fstream>
 #include <mutex>
 #include <regex>
-#include <sstream>
 
 #include "report/output_file.h"
 #include "sim/mujoco_messages.h"
@@ -98,12 +97,17 @@ ModelPtr load_locked(const std::string& path, const mjVFS* vfs = nullptr) {
   return m;
 }
 
+// a scene file's text, read as check_scene_bounds read it: a regular file
+// only, opened without blocking, within the scene's bound
 std::string slurp(const std::string& path) {
-  require_scene_file(path);  // an included file too: never a FIFO
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
+  bool missing = false;
+  try {
+    std::string text = report::read_regular_file(path, kMaxSceneBytes, &missing);
+    if (!missing) return text;
+  } catch (const std::runtime_error& e) {
+    throw SimError(e.what());
+  }
+  throw SimError(path + ": cannot open the scene file");
 }
 
 // An included file less what is only drawn: geoms of a class whose name
