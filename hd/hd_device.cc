@@ -40,7 +40,9 @@ HdDevice::HdDevice(const runtime::BackendRegistry& registry,
   }
   runtime::OpenRequest rq;
   rq.argument = argument;
-  for (const auto& [key, value] : ds.options) {
+  for (const auto& option : ds.options) {
+    const std::string& key = option.first;
+    const std::string& value = option.second;
     const bool taken = std::any_of(
         info.options.begin(), info.options.end(),
         [&](const runtime::BackendOption& o) { return o.key == key; });

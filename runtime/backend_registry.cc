@@ -74,8 +74,8 @@ OpenedDevice BackendRegistry::open(const std::string& spec,
                                    OpenRequest request, bool servo) const {
   std::string argument;
   const BackendInfo& b = resolve(spec, &argument);
-  for (const auto& [key, value] : request.options) {
-    (void)value;
+  for (const auto& option : request.options) {
+    const std::string& key = option.first;
     const bool takes = std::any_of(
         b.options.begin(), b.options.end(),
         [&](const BackendOption& o) { return o.key == key; });

@@ -45,9 +45,9 @@ void EmulatorKinematics::fill(const mjModel* m, const mjData* d,
   mj_comPos(m, k);  // cdof and subtree_com, which mj_jacSite reads
 
   // MuJoCo's arrays are row-major
-  using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  using MjMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
   const Vec3 p_base_m(k->site_xpos + 3 * site_);
-  const Mat3 R_base = Eigen::Map<const RowMat3>(k->site_xmat + 9 * site_);
+  const Mat3 R_base = Eigen::Map<const MjMat3>(k->site_xmat + 9 * site_);
   s->transform_mm.setIdentity();
   s->transform_mm.topLeftCorner<3, 3>() = base_to_device_rotation(R_base);
   s->transform_mm.topRightCorner<3, 1>() = base_to_device_mm(omni_, p_base_m);

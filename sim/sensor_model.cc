@@ -8,7 +8,7 @@ namespace vmh::sim {
 
 SensorModel::SensorModel(const OmniParams& omni, bool enabled)
     : enabled_(enabled) {
-  constexpr double kTwoPi = 6.28318530717958647692;
+  const double two_pi = 2.0 * constants::kPi;
   // joint ranges are given in the DH convention; the device's gimbal angles
   // are the DH ones with t4 = -q4, t6 = -q6, and the ranges are symmetric,
   // so the span is the same; the lower bound is mapped explicitly
@@ -17,7 +17,7 @@ SensorModel::SensorModel(const OmniParams& omni, bool enabled)
   for (int i = 0; i < 6; ++i) {
     const auto k = static_cast<std::size_t>(i);
     if (i < 3) {
-      step_[k] = kTwoPi / omni.encoder_counts_per_rev;
+      step_[k] = two_pi / omni.encoder_counts_per_rev;
       lower_[k] = 0.0;
     } else {
       // 2^bits levels with both ends of the range among them: 2^bits - 1

@@ -10,7 +10,7 @@ namespace vmh::sim {
 
 SimDevice::SimDevice(const mjModel* m, mjData* d, const OmniParams& omni,
                      bool quantize, int delay_ticks, const std::string& source)
-    : m_(m), d_(d), sensor_(omni, quantize), delay_ticks_(delay_ticks) {
+    : d_(d), sensor_(omni, quantize), delay_ticks_(delay_ticks) {
   if (delay_ticks < 0 || delay_ticks > kMaxDelayTicks) {
     throw SimError(source + ": delay_ticks must be in [0, " +
                    std::to_string(kMaxDelayTicks) + "]");

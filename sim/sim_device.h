@@ -45,7 +45,6 @@ class SimDevice final : public HapticDevice {
   const SensorModel& sensor() const { return sensor_; }
 
  private:
-  const mjModel* m_;
   mjData* d_;
   SensorModel sensor_;
   int delay_ticks_;

@@ -590,7 +590,8 @@ void run_cases(std::vector<CaseJob>* jobs,
     if (!w && progress) progress(++finished, jobs->size());
   }
   report::parallel_for(runs.size(), n_threads, [&](std::size_t k) {
-    const auto [c, r] = runs[k];
+    const std::size_t c = runs[k].first;
+    const auto r = runs[k].second;
     if (!work[c]->run(r, stop)) return;
     CaseJob& job = (*jobs)[c];
     record(&job, [&] { job.result = work[c]->finish(stop); });

@@ -34,7 +34,7 @@ void feed(TickTimer* t, const std::vector<double>& periods, double work_s) {
 TEST(TickTimer, RefusesABadPeriod) {
   EXPECT_THROW(TickTimer(0.0), std::invalid_argument);
   EXPECT_THROW(TickTimer(-1e-3), std::invalid_argument);
-  EXPECT_THROW(TickTimer(std::numeric_limits<double>::quiet_NaN()),
+  EXPECT_THROW(TickTimer{std::numeric_limits<double>::quiet_NaN()},
                std::invalid_argument);
 }
 
