@@ -13,7 +13,7 @@
 namespace vmh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using constants::kPi;
 
 void require(bool ok, const std::string& field, const std::string& what) {
   if (!ok) {

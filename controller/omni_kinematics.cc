@@ -8,7 +8,7 @@ namespace vmh {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using vmh::constants::kPi;
 constexpr double kHalfPi = 0.5 * kPi;
 
 // below this horizontal distance (m) the wrist centre is taken to be on the

@@ -12,7 +12,7 @@
 namespace vmh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using constants::kPi;
 
 // below this fraction of L a direction is treated as undefined
 constexpr double kDegenerateFraction = 1e-9;
