@@ -1,7 +1,8 @@
 // `vmhaptics report` as a user runs it: --quick writes one self-contained
 // page and prints its JSON (about 20 s on two cores); a second run with
-// --reuse takes every case and study from the first one's files; bad
-// options are refused with exit 2 and one line.
+// --reuse takes every case and study from the first one's files, and a
+// third runs only what was removed; bad options are refused with exit 2
+// and one line.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -97,16 +98,25 @@ TEST(ReportCliTest, QuickWritesThePageAndReuseTakesItsFiles) {
   EXPECT_EQ(reused_cases, kCases);
   EXPECT_TRUE(k.at("ran").empty()) << k.dump();
   EXPECT_EQ(k.at("claims_passed"), j.at("claims_passed"));
-}
 
-TEST(ReportCliTest, ReuseRunsOnlyWhatIsMissing) {
-  const fs::path dir = vmh::testing::fresh_dir("vmh_report_cli_", "partial");
-  // case 3 alone, as `run` writes it; the rest must run
+  // what is missing runs, and only that: case 3 written again by `run`
+  // (whose files --reuse takes as its own), the precision study's figure
+  // removed (a study runs again when any of its files is missing)
+  fs::remove_all(dir / "case3");
+  ASSERT_TRUE(fs::remove(dir / "study" / "precision.svg"));
   ASSERT_EQ(run("run case3 --out " + dir.string()).exit_code, 0);
-  const auto r = run("report --reuse --quick --out " + dir.string());
-  const json j = json::parse(r.out);
-  EXPECT_EQ(j.at("reused"), json::array({"case3"}));
-  EXPECT_EQ(j.at("ran").size(), 8u) << j.dump();
+  const auto third = run("report --reuse --quick --out " + dir.string());
+  const json t = json::parse(third.out);
+  EXPECT_EQ(third.exit_code, first.exit_code) << third.err;
+  EXPECT_EQ(t.at("ran"), json::array({"precision"})) << t.dump();
+  std::vector<std::string> reused_again;
+  for (const json& r : t.at("reused")) {
+    const std::string name = r.get<std::string>();
+    if (name.rfind("case", 0) == 0) reused_again.push_back(name);
+  }
+  EXPECT_EQ(reused_again, kCases);
+  EXPECT_TRUE(fs::exists(dir / "study" / "precision.svg"));
+  EXPECT_EQ(t.at("claims_passed"), j.at("claims_passed"));
 }
 
 TEST(ReportCliTest, BadOptionsAreRefusedWithOneLine) {
