@@ -324,6 +324,7 @@ bool TraceReader::read_line(std::string_view* line) {
         v = std::string_view(from, take);
       }
       if (!v.empty() && v.back() == '\r') v.remove_suffix(1);
+      check_no_carriage_return(v);
       *line = v;
       return true;
     }
@@ -339,6 +340,7 @@ bool TraceReader::read_line(std::string_view* line) {
       last_line_ended_ = false;
       std::string_view v = line_;
       if (!v.empty() && v.back() == '\r') v.remove_suffix(1);
+      check_no_carriage_return(v);
       *line = v;
       return true;
     }
@@ -359,6 +361,18 @@ bool TraceReader::read_line(std::string_view* line) {
     }
     end_ = static_cast<std::size_t>(n);
   }
+}
+
+// A carriage return is allowed only as the CR of a CRLF line end (taken
+// off before this): one inside a line would end up in a cell, where a
+// column name or a number carries it unseen.
+void TraceReader::check_no_carriage_return(std::string_view line) const {
+  const auto* cr = static_cast<const char*>(std::memchr(line.data(), '\r', line.size()));
+  if (cr == nullptr) return;
+  throw RecordingError(path_ + ":" + std::to_string(line_no_) + ":" +
+                       std::to_string(cr - line.data() + 1) +
+                       ": a carriage return inside the line (only a CRLF line "
+                       "end may hold one)");
 }
 
 void TraceReader::split(std::string_view line) {

@@ -167,6 +167,8 @@ class TraceReader {
  private:
   bool read_line(std::string_view* line);
   void split(std::string_view line);
+  // refuses a carriage return anywhere in line (its CRLF end is off)
+  void check_no_carriage_return(std::string_view line) const;
 
   std::string path_;
   RecordingLimits limits_;

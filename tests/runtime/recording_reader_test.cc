@@ -94,6 +94,19 @@ TEST(TraceReader, ReadsRowsAsWrittenWithLfOrCrlf) {
   }
 }
 
+// found by recording_fuzz: a CR inside a line (not the CR of its CRLF end)
+// used to stay in a cell, unseen in a column name or a text cell
+TEST(TraceReader, ACarriageReturnInsideALineIsRefused) {
+  EXPECT_HAS(trace_refusal(rr_file("cr_cell", "t_s,q1_rad,read_error\n"
+                                              "0.001,0.5,ok\r,\n")),
+             "trace.csv:2:13: a carriage return inside the line");
+  EXPECT_HAS(trace_refusal(rr_file("cr_header", "t_s,q1\r_rad\r\n0.001,0.5\r\n")),
+             "trace.csv:1:7: a carriage return inside the line");
+  // the last line, cut short without its line end
+  EXPECT_HAS(trace_refusal(rr_file("cr_last", "t_s,x\n0.001,1\n0.002,\r2")),
+             "trace.csv:3:7: a carriage return inside the line");
+}
+
 TEST(TraceReader, NumbersAreWholeCellsOrRefused) {
   const fs::path p = rr_file("numbers", "t_s,x\n1,-2.5e3\n2,inf\n3,-nan\n");
   TraceReader r(p.string(), {});
