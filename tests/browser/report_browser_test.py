@@ -265,6 +265,10 @@ def main():
     ap.add_argument("--shots", help="a folder to keep the screenshots in")
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="vmh_browser_")
+    if a.report and not os.path.isfile(a.report):
+        shutil.rmtree(work, ignore_errors=True)
+        sys.exit(f"report_browser_test: no report at {a.report} (ctest's "
+                 "report_cli_test writes it first; run it, or give --cli)")
     report = a.report or make_report(a.cli, os.path.join(work, "report"))
     report_dir = pathlib.Path(report).resolve().parent
     try:
