@@ -27,18 +27,12 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using vmh::testing::first_line;
+using vmh::testing::read_file;
 using vmh::testing::run;
 using vmh::testing::spawn_cli;
 
 fs::path intr_dir(const std::string& name) {
   return vmh::testing::fresh_dir("vmh_interrupt_cli_", name);
-}
-
-std::string intr_read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 
@@ -82,7 +76,7 @@ void intr_record(const fs::path& dir, double seconds) {
 // names is there, under `out`
 void intr_expect_whole_compare_set(const fs::path& out) {
   ASSERT_TRUE(fs::is_regular_file(out / "compare.json")) << out;
-  const json j = json::parse(intr_read(out / "compare.json"));
+  const json j = json::parse(read_file(out / "compare.json"));
   ASSERT_FALSE(j.at("figures").empty());
   for (const json& f : j.at("figures")) {
     const fs::path p = f.get<std::string>();
@@ -125,7 +119,7 @@ TEST(CompareOut, FiguresAreNamedByRecordingAndNeverShareAFolder) {
   EXPECT_FALSE(fs::is_empty(out / "rec"));
   EXPECT_FALSE(fs::is_empty(out / "rec-2"));
   intr_expect_whole_compare_set(out);
-  EXPECT_EQ(json::parse(intr_read(out / "compare.json")), j);
+  EXPECT_EQ(json::parse(read_file(out / "compare.json")), j);
   EXPECT_TRUE(intr_private_folders(out).empty());
 }
 
@@ -162,7 +156,7 @@ TEST(CompareOut, RefusesToReplaceWhatIsNotItsOwn) {
                            (base / "keep").string());
   EXPECT_EQ(foreign.exit_code, 2) << foreign.err;
   EXPECT_NE(foreign.err.find("no compare.json"), std::string::npos) << foreign.err;
-  EXPECT_EQ(intr_read(base / "keep" / "notes.txt"), "mine\n");
+  EXPECT_EQ(read_file(base / "keep" / "notes.txt"), "mine\n");
   EXPECT_TRUE(fs::is_regular_file(base / "rec" / "trace.csv"));
   const auto dot = run("compare " + (base / "rec").string() + " --out .");
   EXPECT_EQ(dot.exit_code, 2) << dot.err;
@@ -191,7 +185,7 @@ TEST(CompareOut, ASignalLeavesThePreviousSetOrAWholeNewOne) {
   const fs::path base = intr_dir("signal");
   const fs::path out = base / "cmp";
   ASSERT_LE(run("compare " + intr_tour().string() + " --out " + out.string()).exit_code, 1);
-  const std::string before = intr_read(out / "compare.json");
+  const std::string before = read_file(out / "compare.json");
   // four copies of the tour, so that the work outlasts the signal's trip
   std::vector<std::string> args = {"compare"};
   for (int i = 0; i < 4; ++i) args.push_back(intr_tour().string());
@@ -210,7 +204,7 @@ TEST(CompareOut, ASignalLeavesThePreviousSetOrAWholeNewOne) {
         << line;
     intr_expect_whole_compare_set(out);
     if (line.find("nothing written") != std::string::npos) {
-      EXPECT_EQ(intr_read(out / "compare.json"), before);
+      EXPECT_EQ(read_file(out / "compare.json"), before);
     }
     EXPECT_TRUE(intr_private_folders(out).empty());
   }
@@ -260,7 +254,7 @@ TEST(HwRunInterrupt, ASignalLeavesNothingOrTheWholeSet) {
     for (const char* f : {"trace.csv", "summary.json", "meta.json"}) {
       EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
     }
-    const json summary = json::parse(intr_read(out / "summary.json"), nullptr, false);
+    const json summary = json::parse(read_file(out / "summary.json"), nullptr, false);
     EXPECT_FALSE(summary.is_discarded());
   }
   EXPECT_TRUE(intr_private_folders(out).empty());

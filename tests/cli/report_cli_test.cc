@@ -21,13 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using vmh::testing::run;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using vmh::testing::read_file;
 
 const std::vector<std::string> kCases = {"case1", "case2", "case3",
                                          "case4", "case5", "case6"};
@@ -58,7 +52,7 @@ TEST(ReportCliTest, QuickWritesThePageAndReuseTakesItsFiles) {
   // the stderr bar is for terminals: none here
   EXPECT_EQ(first.err.find('\r'), std::string::npos);
 
-  const std::string html = slurp(dir / "report.html");
+  const std::string html = read_file(dir / "report.html");
   EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
   EXPECT_NE(html.find("</html>"), std::string::npos);
   EXPECT_EQ(vmh::testing::count(html, "<svg"), vmh::testing::count(html, "</svg>"));

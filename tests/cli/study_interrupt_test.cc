@@ -31,16 +31,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using vmh::testing::read_file;
 
 fs::path sti_dir(const std::string& name) {
   return vmh::testing::fresh_dir("vmh_study_interrupt_", name);
-}
-
-std::string sti_read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 void sti_write(const fs::path& p, const std::string& text) {
@@ -138,7 +132,7 @@ std::map<std::string, std::string> sti_files(const fs::path& dir) {
   std::error_code ec;
   for (const auto& e : fs::recursive_directory_iterator(dir, ec)) {
     if (e.is_regular_file()) {
-      files[fs::relative(e.path(), dir).string()] = sti_read(e.path());
+      files[fs::relative(e.path(), dir).string()] = read_file(e.path());
     }
   }
   return files;
@@ -185,17 +179,17 @@ std::string sti_interrupt(const std::vector<std::string>& args, const std::strin
 
 // sensitivity's three files, whole: the JSON parses and names its points
 void sti_whole_sensitivity(const fs::path& out) {
-  const json j = json::parse(sti_read(out / "sensitivity.json"), nullptr, false);
+  const json j = json::parse(read_file(out / "sensitivity.json"), nullptr, false);
   ASSERT_FALSE(j.is_discarded());
   EXPECT_GT(j.at("point_count").get<int>(), 0);
-  EXPECT_FALSE(sti_read(out / "sensitivity.csv").empty());
-  EXPECT_FALSE(sti_read(out / "sensitivity.svg").empty());
+  EXPECT_FALSE(read_file(out / "sensitivity.csv").empty());
+  EXPECT_FALSE(read_file(out / "sensitivity.svg").empty());
 }
 
 // extremes' files, whole: the JSON parses, and every scenario it names has
 // its series
 void sti_whole_extremes(const fs::path& out) {
-  const json j = json::parse(sti_read(out / "extremes.json"), nullptr, false);
+  const json j = json::parse(read_file(out / "extremes.json"), nullptr, false);
   ASSERT_FALSE(j.is_discarded());
   for (const json& s : j.at("scenarios")) {
     EXPECT_TRUE(fs::is_regular_file(out / "extremes" /
