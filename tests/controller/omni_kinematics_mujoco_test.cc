@@ -27,6 +27,7 @@
 #include "controller/omni_kinematics.h"
 #include "controller/omni_params.h"
 #include "controller/types.h"
+#include "tests/models/model_files.h"
 #include "tests/support/mujoco_kinematics.h"
 #include "tests/support/constants.h"
 
@@ -86,20 +87,16 @@ class MujocoMessageGuard {
 
 // -- raii owners --
 
-struct ModelDeleter {
-  void operator()(mjModel* m) const { mj_deleteModel(m); }
-};
-struct DataDeleter {
-  void operator()(mjData* d) const { mj_deleteData(d); }
-};
 struct VfsDeleter {
   void operator()(mjVFS* vfs) const {
     mj_deleteVFS(vfs);
     delete vfs;
   }
 };
-using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
-using DataPtr = std::unique_ptr<mjData, DataDeleter>;
+// the model tests' owners (tests/models/model_files.h): this test is part
+// of their program (tests/CMakeLists.txt)
+using testing::DataPtr;
+using testing::ModelPtr;
 
 // -- mjcf from the dh table --
 

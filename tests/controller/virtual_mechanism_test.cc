@@ -276,6 +276,26 @@ TEST(VmJacobian, ThesisClosedFormsDefaultMount) {
 
 // ------------------------------------------------------------------ nearest
 
+// the distance from p to the nearest of the points (x, y, z in a row), in
+// plain doubles: the test code is compiled without optimisation, where an
+// Eigen expression per point cost about ten times as much. The square root
+// of the least square is the least of the roots (both correctly rounded).
+double vmt_min_distance(const std::vector<double>& xyz, const Vec3& p) {
+  double best2 = std::numeric_limits<double>::infinity();
+  const double px = p.x(), py = p.y(), pz = p.z();
+  for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) {
+    const double dx = xyz[i] - px, dy = xyz[i + 1] - py, dz = xyz[i + 2] - pz;
+    best2 = std::min(best2, dx * dx + dy * dy + dz * dz);
+  }
+  return std::sqrt(best2);
+}
+
+void vmt_push(std::vector<double>* xyz, const Vec3& x) {
+  xyz->push_back(x.x());
+  xyz->push_back(x.y());
+  xyz->push_back(x.z());
+}
+
 // identity: the circle's nearest() puts the handle at the closest of 100,000
 // sampled points of the circle (none is closer by more than rounding), and
 // the best sample is within the sampling resolution of it
@@ -287,10 +307,11 @@ TEST(VmNearest, CircleIsClosestByBruteForce) {
     const double L = vm.length();
     const Vec3 o = vm.mount().origin;
     const Vec3 e1 = vm.mount().R.col(0), e2 = vm.mount().R.col(1);
-    std::vector<Vec3> path(kSamples);
+    std::vector<double> path;
+    path.reserve(3 * kSamples);
     for (int i = 0; i < kSamples; ++i) {
       const double a = 2 * kPi * i / kSamples;
-      path[static_cast<size_t>(i)] = o + L * (std::cos(a) * e1 + std::sin(a) * e2);
+      vmt_push(&path, o + L * (std::cos(a) * e1 + std::sin(a) * e2));
     }
     for (int k = 0; k < 20; ++k) {
       RmPose rm;
@@ -298,8 +319,7 @@ TEST(VmNearest, CircleIsClosestByBruteForce) {
       VmAngles theta = vm.zero_angles();
       ASSERT_TRUE(vm.nearest(rm, &theta)) << c.name;
       const double d = (vm.pose(theta).p - rm.p).norm();
-      double best = std::numeric_limits<double>::infinity();
-      for (const Vec3& x : path) best = std::min(best, (x - rm.p).norm());
+      const double best = vmt_min_distance(path, rm.p);
       EXPECT_GE(best, d - 1e-12 * (1 + L)) << c.name;
       EXPECT_LE(best, d + 1e-3 * L) << c.name;
     }
@@ -315,16 +335,16 @@ TEST(VmNearest, SphereIsClosestByBruteForce) {
     const VirtualMechanism& vm = *c.vm;
     const double L = vm.length();
     const Vec3 o = vm.mount().origin;
-    std::vector<Vec3> path(kSamples);
-    for (Vec3& x : path) x = o + L * random_unit(&rng);
+    std::vector<double> path;
+    path.reserve(3 * kSamples);
+    for (int i = 0; i < kSamples; ++i) vmt_push(&path, o + L * random_unit(&rng));
     for (int k = 0; k < 10; ++k) {
       RmPose rm;
       rm.p = o + uniform(&rng, 0.1, 3.0) * L * random_unit(&rng);
       VmAngles theta = vm.zero_angles();
       ASSERT_TRUE(vm.nearest(rm, &theta)) << c.name;
       const double d = (vm.pose(theta).p - rm.p).norm();
-      double best = std::numeric_limits<double>::infinity();
-      for (const Vec3& x : path) best = std::min(best, (x - rm.p).norm());
+      const double best = vmt_min_distance(path, rm.p);
       EXPECT_GE(best, d - 1e-12 * (1 + L)) << c.name;
       EXPECT_LE(best, d + 2e-2 * L) << c.name;
       // and it is the radial point, o + L (p - o)/|p - o|
@@ -340,9 +360,15 @@ TEST(VmNearest, SphereIsClosestByBruteForce) {
 // radius L about it (checked against 50,000 random points of that sphere)
 TEST(VmNearest, SurfaceTurnsTheProbeTowardTheRm) {
   std::mt19937 rng(23);
+  std::vector<Vec3> directions(50000);
+  for (Vec3& u : directions) u = random_unit(&rng);
   for (const Case& c : cases({VmKind::kSurface})) {
     const VirtualMechanism& vm = *c.vm;
     const double L = vm.length();
+    // the sphere of radius L about the origin, moved to each contact below
+    std::vector<double> sphere;
+    sphere.reserve(3 * directions.size());
+    for (const Vec3& u : directions) vmt_push(&sphere, L * u);
     for (int k = 0; k < 10; ++k) {
       const VmAngles start = random_theta(vm, &rng);
       const Vec3 contact = link_base(vm, start);
@@ -354,10 +380,7 @@ TEST(VmNearest, SurfaceTurnsTheProbeTowardTheRm) {
       EXPECT_EQ(theta[1], start[1]);
       EXPECT_EQ(theta[4], start[4]);
       const double d = (vm.pose(theta).p - rm.p).norm();
-      double best = std::numeric_limits<double>::infinity();
-      for (int i = 0; i < 50000; ++i) {
-        best = std::min(best, (contact + L * random_unit(&rng) - rm.p).norm());
-      }
+      const double best = vmt_min_distance(sphere, rm.p - contact);
       EXPECT_GE(best, d - 1e-12 * (1 + L)) << c.name;
       EXPECT_LE(best, d + 5e-2 * L) << c.name;
     }
