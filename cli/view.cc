@@ -65,7 +65,7 @@ std::unique_ptr<LiveDevice> open_live(const ViewOptions& o,
   // the case's controller, as hw run builds it
   ControllerParams params;
   try {
-    params = sim::ClosedLoop(scene, o.sets).controller_params();
+    params = sim::load_case(scene, o.sets).controller_params();
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("view: ") + e.what());
   }
@@ -177,7 +177,7 @@ void view(ViewOptions o) {
   } else {
     // bad --set values are usage errors even where no window can open
     try {
-      sim::ClosedLoop check(scene, o.sets);
+      (void)sim::load_case(scene, o.sets);
     } catch (const sim::SimError& e) {
       throw UsageError(std::string("view: ") + e.what());
     }

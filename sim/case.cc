@@ -118,6 +118,27 @@ Case make_case(const std::string& path, const mjModel& m,
               std::move(script), timing);
 }
 
+Case Case::with_gains_scaled(double scale) const {
+  if (!std::isfinite(scale) || !(scale > 0.0)) {
+    throw SimError(path_ + ": a gain scale must be finite and > 0, got " +
+                   case_num(scale));
+  }
+  CaseConfig config = config_;
+  ControllerSettings& k = config.controller;
+  k.k_pos_N_per_mm *= scale;
+  k.k_ornt_multiple *= scale;  // K_ornt = multiple x 2 pi L (eq. 3.28)
+  k.k_vel_Ns_per_mm *= scale;
+  k.k_vel_ornt_Nmms_per_rad *= scale;
+  ControllerParams controller = case_controller_params(config);
+  try {
+    controller.validate();
+  } catch (const std::invalid_argument& e) {
+    throw SimError(path_ + ": " + e.what());
+  }
+  // the script follows the mechanism, not the gains
+  return Case(path_, std::move(config), std::move(controller), script_, t_);
+}
+
 Case load_case(const std::string& path,
                const std::vector<std::string>& overrides,
                const ModelHook& model_hook) {

@@ -74,6 +74,13 @@ ClosedLoop::ClosedLoop(const std::string& scene_path, const mjModel& compiled,
   init();
 }
 
+ClosedLoop::ClosedLoop(const Case& c, const ModelHook& model_hook)
+    : path_(c.scene_path()),
+      model_(load_scene_model(c.scene_path(), model_hook)),
+      case_(c) {
+  init();
+}
+
 void ClosedLoop::init() {
   apply_model_options();
   data_.reset(mj_makeData(model_.get()));

@@ -100,6 +100,10 @@ class ClosedLoop {
   // scene once. `scene_path` names the scene in messages.
   ClosedLoop(const std::string& scene_path, const mjModel& compiled,
              const std::vector<std::string>& overrides);
+  // The loop of a case already read (sim/case.h), its scene compiled again
+  // from the case's file (`model_hook` applied when set): a run of a case
+  // changed after it was read (Case::with_gains_scaled).
+  explicit ClosedLoop(const Case& c, const ModelHook& model_hook = {});
   ~ClosedLoop();
   ClosedLoop(const ClosedLoop&) = delete;
   ClosedLoop& operator=(const ClosedLoop&) = delete;

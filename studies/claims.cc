@@ -88,9 +88,9 @@ double mean_of(const std::vector<double>& v) {
 
 }  // namespace
 
-MetricsAccumulator::MetricsAccumulator(const ClosedLoop& loop)
-    : T_s_(loop.controller_params().servo_period_s),
-      has_settle_(loop.script().segments().size() > 1) {}
+MetricsAccumulator::MetricsAccumulator(const sim::Case& the_case)
+    : T_s_(the_case.controller_params().servo_period_s),
+      has_settle_(the_case.script().segments().size() > 1) {}
 
 void MetricsAccumulator::add(const TickRecord& r) {
   RunMetrics& m = m_;
@@ -129,8 +129,8 @@ RunMetrics MetricsAccumulator::result() const {
 }
 
 RunMetrics run_metrics(const std::vector<TickRecord>& rows,
-                       const ClosedLoop& loop) {
-  MetricsAccumulator acc(loop);
+                       const sim::Case& the_case) {
+  MetricsAccumulator acc(the_case);
   for (const TickRecord& r : rows) acc.add(r);
   return acc.result();
 }
@@ -240,21 +240,21 @@ class Predictions {
 
 std::vector<Claim> measure_claims(int thesis_case,
                                   const std::vector<TickRecord>& rows,
-                                  const ClosedLoop& loop,
+                                  const sim::Case& the_case,
                                   const Predictions& pred);
 
 }  // namespace
 
 std::vector<Claim> evaluate_claims(int thesis_case,
                                    const std::vector<TickRecord>& rows,
-                                   const ClosedLoop& loop) {
-  const Predictions pred(rows, loop.controller_params());
-  std::vector<Claim> claims = measure_claims(thesis_case, rows, loop, pred);
+                                   const sim::Case& the_case) {
+  const Predictions pred(rows, the_case.controller_params());
+  std::vector<Claim> claims = measure_claims(thesis_case, rows, the_case, pred);
   for (Claim& c : claims) {
     const std::set<std::string> names = window_segments(c);
     // the sweep claim uses the whole segment, the others its settled half
     const bool whole = names.count("sweep") > 0;
-    const std::vector<ScriptSegment>& segs = loop.script().segments();
+    const std::vector<ScriptSegment>& segs = the_case.script().segments();
     std::vector<char> in_window(segs.size(), 0);
     for (std::size_t k = 0; k < segs.size(); ++k) {
       in_window[k] = names.count(segs[k].name) > 0 ? 1 : 0;
@@ -573,12 +573,12 @@ void force_grows_claim(const std::vector<TickRecord>& rows,
 
 std::vector<Claim> measure_claims(int thesis_case,
                                   const std::vector<TickRecord>& rows,
-                                  const ClosedLoop& loop,
+                                  const sim::Case& the_case,
                                   const Predictions& pred) {
   std::vector<Claim> claims;
   if (thesis_case < 1 || thesis_case > 6) return claims;
-  const HandScript& script = loop.script();
-  const ControllerParams& p = loop.controller_params();
+  const HandScript& script = the_case.script();
+  const ControllerParams& p = the_case.controller_params();
   if (!(p.gains.k_ornt_Nmm_per_rad > 0.0)) {  // cases 1 and 5
     position_claims(rows, script, pred, &claims);
     return claims;

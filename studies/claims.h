@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/closed_loop.h"
+#include "sim/case.h"
 
 namespace vmh::studies {
 
@@ -119,7 +119,7 @@ inline constexpr double kOnPathMm = 1.0;
 // the run).
 class MetricsAccumulator {
  public:
-  explicit MetricsAccumulator(const sim::ClosedLoop& loop);
+  explicit MetricsAccumulator(const sim::Case& the_case);
   void add(const TickRecord& r);
   RunMetrics result() const;
 
@@ -133,7 +133,7 @@ class MetricsAccumulator {
 
 // RunMetrics over all of `rows`.
 RunMetrics run_metrics(const std::vector<TickRecord>& rows,
-                       const sim::ClosedLoop& loop);
+                       const sim::Case& the_case);
 
 // The gains a case's claims compare against (case 2's for cases 3 and 4),
 // if any.
@@ -143,7 +143,7 @@ std::optional<ControllerParams> reference_params(int thesis_case,
 // The claims of thesis case 1..6 measured on `rows` (empty for 0).
 std::vector<Claim> evaluate_claims(int thesis_case,
                                    const std::vector<TickRecord>& rows,
-                                   const sim::ClosedLoop& loop);
+                                   const sim::Case& the_case);
 
 }  // namespace vmh::studies
 

@@ -53,7 +53,7 @@ Json HwRunCase::run(runtime::OpenedDevice* dev, runtime::SessionOptions so,
       std::max<std::int64_t>(1, (ticks + kMaxKeptTicks - 1) / kMaxKeptTicks);
   const bool truth = dev->truth != nullptr;
   std::optional<MetricsAccumulator> metrics;
-  if (truth) metrics.emplace(*loop_);
+  if (truth) metrics.emplace(loop_->the_case());
   std::vector<TickRecord> rows;
   if (truth) {
     rows.reserve(static_cast<std::size_t>(std::min<std::int64_t>(
@@ -92,7 +92,7 @@ Json HwRunCase::run(runtime::OpenedDevice* dev, runtime::SessionOptions so,
     summary["claims_measured_on"] = "nothing";
     return summary;
   }
-  const std::vector<Claim> claims = evaluate_claims(thesis_case(), rows, *loop_);
+  const std::vector<Claim> claims = evaluate_claims(thesis_case(), rows, loop_->the_case());
   bool pass = true;
   Json cj = Json::array();
   for (const Claim& c : claims) {

@@ -208,9 +208,9 @@ void arrow(Svg& svg, double x1, double y1, double x2, double y2,
               attr("fill", color));
 }
 
-std::string case_name(const ClosedLoop& loop) {
+std::string case_name(const sim::Case& the_case) {
   const std::string stem =
-      std::filesystem::path(loop.config().scene_path()).stem().string();
+      std::filesystem::path(the_case.config().scene_path()).stem().string();
   return stem.empty() ? std::string("run") : stem;
 }
 
@@ -240,10 +240,10 @@ struct Snapshot {
 
 // the row nearest the middle of the settled half of `segment`, if the run
 // has one within a servo period of it
-void find_snapshot(const std::vector<TickRecord>& rows, const ClosedLoop& loop,
+void find_snapshot(const std::vector<TickRecord>& rows, const sim::Case& the_case,
                    Snapshot* s) {
   const ScriptSegment* seg = nullptr;
-  for (const ScriptSegment& g : loop.script().segments()) {
+  for (const ScriptSegment& g : the_case.script().segments()) {
     if (g.name == s->segment) seg = &g;
   }
   if (seg == nullptr) {
@@ -257,7 +257,7 @@ void find_snapshot(const std::vector<TickRecord>& rows, const ClosedLoop& loop,
       best = &r;
     }
   }
-  const double tol = 1.5 * loop.controller_params().servo_period_s;
+  const double tol = 1.5 * the_case.controller_params().servo_period_s;
   if (best == nullptr || std::abs(best->t_s - mid) > tol) {
     s->note = "t = " + plot_num(mid) + " s (" + s->segment + ") is not in the run";
     return;
@@ -490,16 +490,16 @@ struct HistoryPanel {
 }  // namespace
 
 std::string views_svg(const std::vector<TickRecord>& rows,
-                      const ClosedLoop& loop) {
-  const std::string name = case_name(loop);
+                      const sim::Case& the_case) {
+  const std::string name = case_name(the_case);
   if (rows.empty()) return empty_document(name);
-  const VmParams& vm = loop.controller_params().vm;
+  const VmParams& vm = the_case.controller_params().vm;
 
   std::vector<Snapshot> snaps = {
       {"off_out_misaligned", "off", "RM off the path", nullptr, ""},
       {"on_misaligned_a", "on", "RM on the path", nullptr, ""},
   };
-  for (Snapshot& s : snaps) find_snapshot(rows, loop, &s);
+  for (Snapshot& s : snaps) find_snapshot(rows, the_case, &s);
 
   std::vector<Projection> projs;
   if (vm.kind == VmKind::kCircle) {
@@ -545,8 +545,8 @@ std::string views_svg(const std::vector<TickRecord>& rows,
 }
 
 std::string history_svg(const std::vector<TickRecord>& rows,
-                        const ClosedLoop& loop) {
-  const std::string name = case_name(loop);
+                        const sim::Case& the_case) {
+  const std::string name = case_name(the_case);
   if (rows.empty()) return empty_document(name);
 
   const char* const kColor[3] = {"#d62728", "#2ca02c", "#1f77b4"};
@@ -594,7 +594,7 @@ std::string history_svg(const std::vector<TickRecord>& rows,
   const double t_end = static_cast<double>(step_index_up(t1, tstep)) * tstep;
   if (t_end - t1 < 0.02 * (t1 - t0)) t1 = t_end;
   const std::vector<std::size_t> idx = decimated(rows.size());
-  const std::vector<ScriptSegment>& segs = loop.script().segments();
+  const std::vector<ScriptSegment>& segs = the_case.script().segments();
 
   for (std::size_t k = 0; k < panels.size(); ++k) {
     const HistoryPanel& hp = panels[k];

@@ -30,7 +30,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/closed_loop.h"
+#include "device/tick_record.h"
+#include "sim/case.h"
 
 namespace vmh::studies {
 
@@ -42,9 +43,9 @@ inline constexpr double kPlotStylusMm = 15.0;
 inline constexpr std::size_t kPlotMaxPoints = 2000;
 
 std::string views_svg(const std::vector<TickRecord>& rows,
-                      const sim::ClosedLoop& loop);
+                      const sim::Case& the_case);
 std::string history_svg(const std::vector<TickRecord>& rows,
-                        const sim::ClosedLoop& loop);
+                        const sim::Case& the_case);
 
 }  // namespace vmh::studies
 

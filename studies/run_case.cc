@@ -350,7 +350,7 @@ class CaseWork {
     const ScriptSettings& script = loop_->config().script;
     first_label_ = side_label(script.dir, script.off_mm, "");
     // the claims' windows, which say what each side must simulate
-    window_claims_ = evaluate_claims(thesis_case_, {}, *loop_);
+    window_claims_ = evaluate_claims(thesis_case_, {}, loop_->the_case());
     if (window_claims_.empty()) return;
     const Vec3& axis = script.axis;
     // the start direction d (stylus axis `a` if set) and its mirror image
@@ -387,7 +387,7 @@ class CaseWork {
     ClosedLoop& loop = *loop_;
     result_.kept_every = kept_every(loop);
     const auto start = std::chrono::steady_clock::now();
-    MetricsAccumulator metrics(loop);
+    MetricsAccumulator metrics(loop.the_case());
     std::vector<TickRecord>& rows = row_buffer(0);
     run_to_end(&loop, stop, trace_.get(), &metrics, &rows);
     const auto end = std::chrono::steady_clock::now();
@@ -397,10 +397,10 @@ class CaseWork {
     // over every tick; the claims and figures over the kept ones, made now
     // so that the rows' memory goes to this thread's next run
     result_.metrics = metrics.result();
-    result_.claims = evaluate_claims(thesis_case_, rows, loop);
+    result_.claims = evaluate_claims(thesis_case_, rows, loop.the_case());
     if (set_) {
-      views_ = views_svg(rows, loop);
-      history_ = history_svg(rows, loop);
+      views_ = views_svg(rows, loop.the_case());
+      history_ = history_svg(rows, loop.the_case());
     }
     std::lock_guard<std::mutex> lock(mutex_);
     add_warnings(loop);
@@ -424,7 +424,7 @@ class CaseWork {
     std::vector<TickRecord>& rows = row_buffer(1);
     run_side(&l, plan, options_.sides, stop, side_trace.get(), &st, &rows);
     if (side_trace) side_trace->close();
-    side.claims = evaluate_claims(thesis_case_, rows, l);
+    side.claims = evaluate_claims(thesis_case_, rows, l.the_case());
     side.stats = {{"where", side.off_path_only ? side.label.where_off_path
                                                : side.label.where},
                   {"overrides", side.extra},

@@ -20,6 +20,7 @@
 #include "report/progress.h"
 #include "sim/mujoco_messages.h"
 #include "sim/case_catalogue.h"
+#include "sim/closed_loop.h"
 #include "studies/claims.h"
 #include "studies/stop.h"
 

@@ -473,8 +473,8 @@ PointResult run_point(const SweepPlan& plan, std::size_t index,
       rows.emplace_back();
       loop.tick(&rows.back());
     }
-    r.rms_path_error_mm = run_metrics(rows, loop).rms_path_error_mm;
-    for (const Claim& cl : evaluate_claims(thesis_case, rows, loop)) {
+    r.rms_path_error_mm = run_metrics(rows, loop.the_case()).rms_path_error_mm;
+    for (const Claim& cl : evaluate_claims(thesis_case, rows, loop.the_case())) {
       r.claims.push_back({cl.name, cl.value, cl.threshold, cl.comparison,
                           cl.unit, static_cast<bool>(cl.pass)});
     }

@@ -77,13 +77,6 @@ std::vector<std::string> overrides_of(const Recording& r,
   return out;
 }
 
-void scale_gains(double s, Gains* g) {
-  g->k_pos_N_per_mm *= s;
-  g->k_ornt_Nmm_per_rad *= s;
-  g->k_vel_Ns_per_mm *= s;
-  g->k_vel_ornt_Nmms_per_rad *= s;
-}
-
 struct Series {
   std::vector<double> t_s, e_mm, F_N;
   double rms(const std::vector<double>& v) const {
@@ -219,20 +212,10 @@ void simulate(const Recording& r, const std::string& scene,
     script_s = std::max(duration_s, r.meta["session"]["duration_s"].get<double>());
   }
   overrides.push_back("duration_s=" + replay_fmt(std::max(script_s, 1e-3), 9));
-  // the gains as hw run scaled them, in the scene's own parameters
-  {
-    const sim::Case probe = sim::load_case(scene, overrides);
-    const sim::ControllerSettings& cs = probe.config().controller;
-    overrides.push_back("k_pos_N_per_mm=" +
-                        replay_fmt(gain_scale * cs.k_pos_N_per_mm, 17));
-    overrides.push_back("k_ornt_multiple=" +
-                        replay_fmt(gain_scale * cs.k_ornt_multiple, 17));
-    overrides.push_back("k_vel_Ns_per_mm=" +
-                        replay_fmt(gain_scale * cs.k_vel_Ns_per_mm, 17));
-    overrides.push_back("k_vel_ornt_Nmms_per_rad=" +
-                        replay_fmt(gain_scale * cs.k_vel_ornt_Nmms_per_rad, 17));
-  }
-  sim::ClosedLoop loop(scene, overrides);
+  // the case as the session ran it: its gains scaled as hw run scaled them
+  const sim::Case session =
+      sim::load_case(scene, overrides).with_gains_scaled(gain_scale);
+  sim::ClosedLoop loop(session);
   Series sim;
   TickRecord row;
   while (!loop.finished()) {
@@ -312,9 +295,9 @@ CompareSection compare_closed_loop(const Recording& r, const ReplayOptions& o,
   std::string gain_source;
   const double gain_scale = gain_scale_of(r, o, &gain_source);
   const std::vector<std::string> overrides = overrides_of(r, o);
-  ControllerParams params =
-      sim::ClosedLoop(scene, overrides).controller_params();
-  scale_gains(gain_scale, &params.gains);
+  const ControllerParams params = sim::load_case(scene, overrides)
+                                     .with_gains_scaled(gain_scale)
+                                     .controller_params();
   s.detail["scene"] = scene;
   s.detail["overrides"] = overrides;
   s.detail["gain_scale"] = gain_scale;

@@ -9,7 +9,9 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -102,6 +104,64 @@ TEST(Case, ALoopRunsTheCaseReadAlone) {
     ++n;
   }
   EXPECT_EQ(n, alone.ticks_per_run());
+}
+
+// Scaled gains against the same case with its four gains set by `--set`
+// at the scaled values (the scene's own parameters, an independent route
+// through the case table), on case 3 with an orientation damping added so
+// that every gain is non-zero; and a loop over the scaled case runs those
+// gains with the case's script
+TEST(Case, ScaledGainsAreTheGainsSetByHand) {
+  const double s = 0.37;
+  const Case base = load_case(kCase3, {"k_vel_ornt_Nmms_per_rad=2.5"});
+  const ControllerSettings& k = base.config().controller;
+  ASSERT_GT(k.k_ornt_multiple, 0.0);
+  ASSERT_GT(k.k_vel_ornt_Nmms_per_rad, 0.0);
+  auto num = [](double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::string(buf);
+  };
+  const Case by_hand = load_case(
+      kCase3, {"k_pos_N_per_mm=" + num(s * k.k_pos_N_per_mm),
+               "k_ornt_multiple=" + num(s * k.k_ornt_multiple),
+               "k_vel_Ns_per_mm=" + num(s * k.k_vel_Ns_per_mm),
+               "k_vel_ornt_Nmms_per_rad=" + num(s * k.k_vel_ornt_Nmms_per_rad)});
+  const Case scaled = base.with_gains_scaled(s);
+  const Gains& g = scaled.controller_params().gains;
+  const Gains& h = by_hand.controller_params().gains;
+  EXPECT_NEAR(g.k_pos_N_per_mm, h.k_pos_N_per_mm, 1e-12 * h.k_pos_N_per_mm);
+  EXPECT_NEAR(g.k_ornt_Nmm_per_rad, h.k_ornt_Nmm_per_rad,
+              1e-12 * h.k_ornt_Nmm_per_rad);
+  EXPECT_NEAR(g.k_vel_Ns_per_mm, h.k_vel_Ns_per_mm, 1e-12 * h.k_vel_Ns_per_mm);
+  EXPECT_NEAR(g.k_vel_ornt_Nmms_per_rad, h.k_vel_ornt_Nmms_per_rad,
+              1e-12 * h.k_vel_ornt_Nmms_per_rad);
+  EXPECT_NEAR(g.k_pos_N_per_mm, 0.37 * 0.6, 1e-12);  // case 3's K_pos
+  EXPECT_NEAR(scaled.config().controller.k_pos_N_per_mm, 0.37 * 0.6, 1e-12);
+  // the rest of the case is the case's own
+  EXPECT_EQ(scaled.scene_path(), base.scene_path());
+  EXPECT_EQ(scaled.ticks_per_run(), base.ticks_per_run());
+  EXPECT_EQ(scaled.script().segments().size(), base.script().segments().size());
+  EXPECT_DOUBLE_EQ(scaled.controller_params().vm.length_mm,
+                   base.controller_params().vm.length_mm);
+  ClosedLoop loop(scaled);
+  EXPECT_DOUBLE_EQ(loop.controller_params().gains.k_pos_N_per_mm, g.k_pos_N_per_mm);
+  EXPECT_DOUBLE_EQ(loop.controller().params().gains.k_ornt_Nmm_per_rad,
+                   g.k_ornt_Nmm_per_rad);
+  EXPECT_EQ(loop.ticks_per_run(), base.ticks_per_run());
+}
+
+TEST(Case, AGainScaleMustBeFiniteAndPositive) {
+  const Case base = load_case(kCase1, {});
+  for (double s : {0.0, -1.0, std::nan(""), HUGE_VAL}) {
+    try {
+      (void)base.with_gains_scaled(s);
+      ADD_FAILURE() << "scale " << s << " was taken";
+    } catch (const SimError& e) {
+      EXPECT_NE(std::string(e.what()).find(kCase1), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("gain scale"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Case, RefusesWhatALoopRefusedNamingTheFileAndField) {

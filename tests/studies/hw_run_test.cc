@@ -59,7 +59,7 @@ std::vector<TickRecord> run_loop(sim::ClosedLoop* loop, RunMetrics* metrics) {
                                   loop->controller_params())) {
     loop->set_reference(*ref);
   }
-  MetricsAccumulator acc(*loop);
+  MetricsAccumulator acc(loop->the_case());
   std::vector<TickRecord> rows;
   TickRecord row;
   while (!loop->finished()) {
@@ -98,7 +98,7 @@ TEST_P(HwRunLockstep, MatchesTheSimulatedLoopBehindTheSafetyLayer) {
   const std::vector<TickRecord> rows = run_loop(&loop, &m);
   ASSERT_EQ(session.ticks, static_cast<long>(rows.size()));
   const std::vector<Claim> claims =
-      evaluate_claims(loop.config().thesis_case, rows, loop);
+      evaluate_claims(loop.config().thesis_case, rows, loop.the_case());
 
   const Json& hm = summary.at("metrics");
   EXPECT_EQ(hm.at("ticks").get<int>(), m.ticks);

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/closed_loop.h"
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/svg_check.h"
 
@@ -53,8 +54,8 @@ const CaseRun& run(int n) {
         scene(n), std::vector<std::string>{"duration_s=20"});
     r->rows.resize(static_cast<std::size_t>(r->loop->ticks_per_run()));
     for (TickRecord& row : r->rows) r->loop->tick(&row);
-    r->views = views_svg(r->rows, *r->loop);
-    r->history = history_svg(r->rows, *r->loop);
+    r->views = views_svg(r->rows, r->loop->the_case());
+    r->history = history_svg(r->rows, r->loop->the_case());
     if (const char* dir = std::getenv("VMH_PLOT_SVG_DIR")) {
       const std::string base = std::string(dir) + "/case" + std::to_string(n);
       std::ofstream(base + "_views.svg") << r->views;
@@ -126,7 +127,7 @@ TEST(PlotSvgTest, DocumentsAreWellFormedSvg) {
   }
   // no rows: still a document
   const CaseRun& r = run(2);
-  for (const std::string& doc : {views_svg({}, *r.loop), history_svg({}, *r.loop)}) {
+  for (const std::string& doc : {views_svg({}, r.loop->the_case()), history_svg({}, r.loop->the_case())}) {
     EXPECT_EQ(tag_problems(doc), "");
     EXPECT_NE(doc.find("no rows"), std::string::npos);
   }

@@ -30,7 +30,7 @@ std::vector<Claim> main_claims(sim::ClosedLoop* loop) {
                        static_cast<int>(loop->script().segments().size()) - 1};
   std::vector<TickRecord> rows;
   run_side(loop, every, SideMode::kFull, {}, nullptr, nullptr, &rows);
-  return evaluate_claims(loop->config().thesis_case, rows, *loop);
+  return evaluate_claims(loop->config().thesis_case, rows, loop->the_case());
 }
 
 std::set<std::string> read_names(const sim::HandScript& s, const SidePlan& p) {
@@ -122,7 +122,7 @@ TEST(SideRuns, SettledHoldsEndEarly) {
     EXPECT_GE(n, kMeasuredTicks) << fitted.script().segments()[k].name;
   }
   const std::vector<Claim> got =
-      evaluate_claims(1, rows, fitted);
+      evaluate_claims(1, rows, fitted.the_case());
   ASSERT_EQ(got.size(), claims.size());
   for (std::size_t i = 0; i < got.size(); ++i) {
     EXPECT_EQ(got[i].pass, claims[i].pass) << got[i].name;
