@@ -402,10 +402,10 @@ SweepPlan plan_sweep(const SensitivityOptions& options) {
   }
 
   // the definition the id hashes: what was asked and every point's settings
-  using Json = nlohmann::ordered_json;
-  Json params = Json::array();
+  using IdJson = nlohmann::ordered_json;
+  IdJson params = IdJson::array();
   for (const SweepParameter& p : plan.parameters) {
-    Json j = {{"name", p.name}, {"field", p.field.empty() ? Json() : Json(p.field)}};
+    IdJson j = {{"name", p.name}, {"field", p.field.empty() ? IdJson() : IdJson(p.field)}};
     if (p.scale == SweepScale::kChoice) {
       j["choices"] = p.choices;
     } else {
@@ -419,13 +419,13 @@ SweepPlan plan_sweep(const SensitivityOptions& options) {
     j["source"] = p.source;
     params.push_back(j);
   }
-  Json points = Json::array();
+  IdJson points = IdJson::array();
   for (const SweepPoint& pt : plan.points) {
     points.push_back({pt.index, plan.cases[pt.case_index].name,
                       point_kind_name(pt.kind), pt.overrides,
                       exact(pt.omni_mass_scale), exact(pt.omni_friction_scale)});
   }
-  Json case_names = Json::array();
+  IdJson case_names = IdJson::array();
   for (const SweepCase& c : plan.cases) case_names.push_back(c.name);
   plan.definition = {{"software", options.software},
                      {"cases", case_names},
