@@ -17,7 +17,7 @@
 // SIGTERM (nothing written, --out left as it was, unless the signal came
 // after the set was in place: then the set is whole).
 //
-// --out DIR is one output set (report/output_file.h): compare.json and each
+// --out DIR is one output set (output/output_file.h): compare.json and each
 // recording's figures, in DIR/<recording's name>/, are written into a
 // private folder beside DIR which then replaces DIR whole; a reader sees
 // the previous set or the new one, and of two runs at once the last to
@@ -41,7 +41,7 @@
 #include "device/stop_signal.h"
 #include "runtime/json_util.h"
 #include "runtime/stop.h"
-#include "report/output_file.h"
+#include "output/output_file.h"
 #include "sim/mujoco_util.h"
 #include "studies/bringup/compare_check.h"
 #include "studies/bringup/compare_force.h"
@@ -196,13 +196,13 @@ void compare(const CompareOptions& o) {
 
   // the set: each recording's figures in <its name>/ of a private folder,
   // which replaces --out whole once compare.json is beside them
-  std::unique_ptr<report::OutputSet> set;
+  std::unique_ptr<output::OutputSet> set;
   std::string out_dir;
   std::vector<std::string> folder_names;  // of each recording's figures
   if (!o.out.empty()) {
     out_dir = check_out(o.out, recs);
     try {
-      set = std::make_unique<report::OutputSet>(out_dir);
+      set = std::make_unique<output::OutputSet>(out_dir);
     } catch (const std::runtime_error& e) {
       throw UsageError("compare: --out '" + o.out + "': " + e.what());
     }

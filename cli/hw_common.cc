@@ -103,7 +103,7 @@ runtime::SessionOptions session_options(const HwCommon& c, const std::string& ve
   return o;
 }
 
-std::unique_ptr<report::OutputSet> hw_output_set(const std::string& verb,
+std::unique_ptr<output::OutputSet> hw_output_set(const std::string& verb,
                                                  const std::string& out,
                                                  bool given) {
   if (!given) return nullptr;
@@ -117,13 +117,13 @@ std::unique_ptr<report::OutputSet> hw_output_set(const std::string& verb,
                      "' is not a folder (it is a file)");
   }
   try {
-    return std::make_unique<report::OutputSet>(out);
+    return std::make_unique<output::OutputSet>(out);
   } catch (const std::runtime_error& e) {
     throw UsageError("hw " + verb + ": --out '" + out + "': " + e.what());
   }
 }
 
-void trace_into(report::OutputSet* set, const std::string& out,
+void trace_into(output::OutputSet* set, const std::string& out,
                 runtime::SessionOptions* so) {
   if (set == nullptr) return;
   so->trace_path = (fs::path(set->temp_dir()) / "trace.csv").string();

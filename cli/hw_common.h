@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "report/output_file.h"
+#include "output/output_file.h"
 #include "runtime/backend_registry.h"
 #include "runtime/json_util.h"
 #include "runtime/session.h"
@@ -67,11 +67,11 @@ runtime::SessionOptions session_options(const HwCommon& c, const std::string& ve
 // name) is a usage error (exit 2) with nothing opened or written. Null
 // when `out` was not given. trace.csv goes into its private folder as the
 // session runs; commit() puts trace, meta and summary in place together.
-std::unique_ptr<report::OutputSet> hw_output_set(const std::string& verb,
+std::unique_ptr<output::OutputSet> hw_output_set(const std::string& verb,
                                                  const std::string& out,
                                                  bool given);
 // the session's trace path in the set and the path it will have
-void trace_into(report::OutputSet* set, const std::string& out,
+void trace_into(output::OutputSet* set, const std::string& out,
                 runtime::SessionOptions* so);
 
 }  // namespace vmh::cli

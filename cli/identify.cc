@@ -30,8 +30,8 @@
 #include "runtime/session.h"
 #include "runtime/stop.h"
 #include "runtime/json_util.h"
-#include "report/output_file.h"
-#include "report/svg_chart.h"
+#include "output/output_file.h"
+#include "output/svg_chart.h"
 #include "studies/bringup/identify.h"
 #include "studies/bringup/recording.h"
 #include "studies/run_case.h"
@@ -103,13 +103,13 @@ std::string serial_of(const std::vector<bringup::Recording>& recs,
 
 // measured, nominal and fitted response of each window's pushed joint
 std::string fit_figure(const bringup::IdentifyResult& r) {
-  report::ChartGrid grid;
+  output::ChartGrid grid;
   grid.title = "identify: pushed joint, measured vs simulated before and after the fit";
   grid.notes.push_back("device angles t1..t3 (rad); nominal = the model as written");
   grid.notes.push_back("fitted: " + sim::omni_edit_text(r.edit));
   grid.columns = 3;
   for (const bringup::WindowTrace& w : r.traces) {
-    report::Chart c;
+    output::Chart c;
     c.title = std::filesystem::path(r.recordings[w.recording].dir).filename().string() +
               ", motor " + std::to_string(w.motor);
     c.x.label = "time from window start (s)";
@@ -123,7 +123,7 @@ std::string fit_figure(const bringup::IdentifyResult& r) {
     c.height_px = 300;
     grid.panels.push_back(std::move(c));
   }
-  return report::chart_grid_svg(grid);
+  return output::chart_grid_svg(grid);
 }
 
 Json result_json(const bringup::IdentifyResult& r, const std::vector<std::string>& fit) {
@@ -199,11 +199,11 @@ void identify_verb(const IdentifyCliOptions& o) {
                                 ? sim::models_dir() + "/omni/calibrated/" + serial + ".xml"
                                 : o.model_out;
   try {
-    if (!o.out.empty()) report::check_writable_dir(o.out);
+    if (!o.out.empty()) output::check_writable_dir(o.out);
     const std::filesystem::path model_dir =
         std::filesystem::path(model).parent_path();
-    if (!model_dir.empty()) report::check_writable_dir(model_dir.string());
-    report::check_replaceable(model);
+    if (!model_dir.empty()) output::check_writable_dir(model_dir.string());
+    output::check_replaceable(model);
   } catch (const std::runtime_error& e) {
     throw UsageError(std::string("identify: ") + e.what());
   }
@@ -248,8 +248,8 @@ void identify_verb(const IdentifyCliOptions& o) {
   out["run_time_s"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!o.out.empty()) {
-    report::write_file_in(o.out, "identify_fit.svg", figure);
-    report::write_file_in(o.out, "identify.json", dump_readable(out) + "\n");
+    output::write_file_in(o.out, "identify_fit.svg", figure);
+    output::write_file_in(o.out, "identify.json", dump_readable(out) + "\n");
   }
   // a signal while the files went out: they are whole, and the exit says so
   runtime::throw_if_stopped("identify", "; its files were already written (" +

@@ -26,7 +26,7 @@
 
 #include "cli/args.h"
 #include "device/stop_signal.h"
-#include "report/parallel.h"
+#include "output/parallel.h"
 #include "runtime/json_util.h"
 #include "runtime/stop.h"
 #include "studies/report_job.h"
@@ -115,7 +115,7 @@ void run(const ReportCli& o) {
   studies::ReportJob job;
   job.out_dir = o.out;
   job.reuse = o.reuse;
-  job.jobs = o.jobs > 0 ? o.jobs : report::core_count();
+  job.jobs = o.jobs > 0 ? o.jobs : output::core_count();
   job.quick = o.quick;
   job.command_line = command_line(o);
   job.version = VMH_VERSION;

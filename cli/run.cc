@@ -24,8 +24,8 @@
 #include "cli/args.h"
 #include "runtime/session.h"
 #include "device/stop_signal.h"
-#include "report/output_file.h"
-#include "report/progress.h"
+#include "output/output_file.h"
+#include "output/progress.h"
 #include "sim/case_params.h"
 #include "studies/run_case.h"
 
@@ -142,7 +142,7 @@ void run(const RunOptions& o) {
   // an --out that cannot hold the sets is found before any run
   if (!o.out.empty()) {
     try {
-      report::check_writable_dir(o.out);
+      output::check_writable_dir(o.out);
     } catch (const std::exception& e) {
       throw UsageError(std::string("run: --out ") + e.what());
     }
@@ -158,9 +158,9 @@ void run(const RunOptions& o) {
     StopSignals signals;
     {
       // a bar on stderr (terminal only) for --all; one case is one item
-      report::Progress bar("run", runs.size());
+      output::Progress bar("run", runs.size());
       studies::run_cases(&runs, sets, o.out, o.jobs, model,
-                         o.all ? bar.part(0) : report::ProgressFn{},
+                         o.all ? bar.part(0) : output::ProgressFn{},
                          [&signals] { return signals.requested(); },
                          run_options);
     }

@@ -22,8 +22,8 @@
 #include "cli/study.h"
 #include "cli/study_files.h"
 #include "device/stop_signal.h"
-#include "report/parallel.h"
-#include "report/progress.h"
+#include "output/parallel.h"
+#include "output/progress.h"
 #include "studies/extremes_study.h"
 
 namespace vmh::cli {
@@ -70,12 +70,12 @@ void run(const ExtremesCli& o) {
   studies::ExtremesOptions p;
   p.only = o.only;
   p.out_dir = o.out;
-  p.jobs = o.jobs > 0 ? o.jobs : report::core_count();
+  p.jobs = o.jobs > 0 ? o.jobs : output::core_count();
   p.should_stop = study_stop();
   studies::ExtremesResult r;
   try {
     // the bar (on a terminal) is finished before the JSON or the table
-    report::Progress bar("study extremes",
+    output::Progress bar("study extremes",
                          o.only.empty() ? studies::extreme_scenarios().size()
                                         : o.only.size());
     p.progress = bar.part(0);

@@ -23,7 +23,7 @@
 #include "cli/study.h"
 #include "cli/study_files.h"
 #include "device/stop_signal.h"
-#include "report/progress.h"
+#include "output/progress.h"
 #include "sim/case.h"
 #include "sim/mujoco_util.h"
 #include "studies/precision_study.h"
@@ -166,7 +166,7 @@ void run(const PrecisionCli& o) {
   check_against_case(p);
   studies::PrecisionResult r;
   try {
-    report::Progress bar("study precision", 0);
+    output::Progress bar("study precision", 0);
     studies::PrecisionOptions with_bar = p;
     with_bar.progress = bar.part(0);
     with_bar.should_stop = study_stop();

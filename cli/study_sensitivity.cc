@@ -28,8 +28,8 @@
 #include "cli/study.h"
 #include "cli/study_files.h"
 #include "device/stop_signal.h"
-#include "report/parallel.h"
-#include "report/progress.h"
+#include "output/parallel.h"
+#include "output/progress.h"
 #include "sim/mujoco_util.h"
 #include "studies/run_case.h"
 #include "studies/sensitivity_study.h"
@@ -180,10 +180,10 @@ void run(const SensitivityCli& o) {
   const std::size_t count = n > 0 ? which.size() : plan.points.size();
   std::vector<studies::PointResult> results;
   {
-    report::Progress bar("study sensitivity", count);
+    output::Progress bar("study sensitivity", count);
     results = run_stoppable("study sensitivity", [&] {
       return studies::run_points(plan, which,
-                                 o.jobs > 0 ? o.jobs : report::core_count(),
+                                 o.jobs > 0 ? o.jobs : output::core_count(),
                                  bar.part(0), study_stop());
     });
   }

@@ -31,9 +31,9 @@
 #include "cli/study.h"
 #include "cli/study_files.h"
 #include "device/stop_signal.h"
-#include "report/output_file.h"
-#include "report/parallel.h"
-#include "report/progress.h"
+#include "output/output_file.h"
+#include "output/parallel.h"
+#include "output/progress.h"
 #include "studies/run_case.h"
 #include "studies/stability_study.h"
 
@@ -74,7 +74,7 @@ constexpr double kDefaultMapBMaxTimesMOverT = 0.1;
 // stopped by a signal leaves no folder of its own; the writers create it)
 void make_out_dir(const std::string& out) {
   try {
-    report::check_writable_dir(out);
+    output::check_writable_dir(out);
   } catch (const std::runtime_error& e) {
     throw UsageError("--out: cannot create directory '" + out + "' (" +
                      e.what() + ")");
@@ -113,7 +113,7 @@ std::string number_text(double v) {
 // `bar` (if any) is finished before the JSON, so that a terminal shows it
 // whole above it
 void run_study(const studies::StabilityOptions& p,
-               report::Progress* bar = nullptr) {
+               output::Progress* bar = nullptr) {
   studies::StabilityResult r;
   studies::StabilityOptions stoppable = p;
   stoppable.should_stop = study_stop();
@@ -163,7 +163,7 @@ void run_map(const StabilityCli& o, const studies::StabilityParams& base) {
   so.model_path = studies::slider_model_path(sim::models_dir());
   so.params = base;
   so.rel_tol = o.tolerance;
-  so.jobs = o.jobs > 0 ? o.jobs : report::core_count();
+  so.jobs = o.jobs > 0 ? o.jobs : output::core_count();
   // with b = 0 the sweep starts one step above B = 0, where nothing is
   // stable
   const int first = base.damping_Ns_per_m > 0.0 ? 0 : 1;
@@ -177,7 +177,7 @@ void run_map(const StabilityCli& o, const studies::StabilityParams& base) {
   }
   so.out_dir = o.out;
   make_out_dir(o.out);
-  report::Progress bar("study stability --map",
+  output::Progress bar("study stability --map",
                        so.map_virtual_damping_Ns_per_m.size() *
                            so.map_delay_ticks.size());
   so.progress = bar.part(0);

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "report/output_file.h"
+#include "output/output_file.h"
 
 namespace vmh::runtime {
 namespace {
@@ -161,7 +161,7 @@ std::optional<StoredCalibration> load_calibration(const std::string& serial) {
   bool missing = false;
   std::string text;
   try {
-    text = report::read_regular_file(path, kMaxFileBytes, &missing);
+    text = output::read_regular_file(path, kMaxFileBytes, &missing);
   } catch (const std::runtime_error& e) {
     throw CalibrationError(std::string(e.what()) + " (not a calibration)");
   }
@@ -206,7 +206,7 @@ std::string save_calibration(const StoredCalibration& c) {
          {"pot_offset_rad", c.calibration.pot_offset_rad},
          {"details", c.details}};
   fs::create_directories(fs::path(path).parent_path());
-  report::write_file_atomically(path, dump_readable(j) + "\n");
+  output::write_file_atomically(path, dump_readable(j) + "\n");
   return path;
 }
 

@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "report/output_file.h"
+#include "output/output_file.h"
 
 namespace vmh::runtime {
 namespace {
@@ -18,7 +18,7 @@ constexpr std::size_t kReadChunk = std::size_t{1} << 20;
 // the largest finite double: a bound that only says "finite"
 constexpr double kHuge = std::numeric_limits<double>::max();
 
-using report::bytes_text;
+using output::bytes_text;
 
 // a cell, shown in a message: at most 40 characters, control characters
 // escaped, so that a binary file's bytes do not end up on the terminal
@@ -120,7 +120,7 @@ class MetaChecker {
 int open_regular_file(const std::string& path, std::uint64_t max_bytes,
                       bool* missing) {
   try {
-    return report::open_regular_file(path, max_bytes, missing);
+    return output::open_regular_file(path, max_bytes, missing);
   } catch (const std::runtime_error& e) {
     throw RecordingError(e.what());
   }
@@ -129,7 +129,7 @@ int open_regular_file(const std::string& path, std::uint64_t max_bytes,
 std::string read_regular_file(const std::string& path, std::uint64_t max_bytes,
                               bool* missing) {
   try {
-    return report::read_regular_file(path, max_bytes, missing);
+    return output::read_regular_file(path, max_bytes, missing);
   } catch (const std::runtime_error& e) {
     throw RecordingError(e.what());
   }

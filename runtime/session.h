@@ -19,7 +19,7 @@
 // So a session cut short (a signal, a device gone) keeps its trace up to
 // the last tick, and the device is left at zero torque. The trace goes
 // where the caller says: a verb gives the private folder of its output set
-// (report::OutputSet), so that trace.csv, meta.json and summary.json
+// (output::OutputSet), so that trace.csv, meta.json and summary.json
 // appear together or not at all.
 #ifndef VMHAPTICS_RUNTIME_SESSION_H_
 #define VMHAPTICS_RUNTIME_SESSION_H_

@@ -8,7 +8,7 @@
 #include <mutex>
 #include <regex>
 
-#include "report/output_file.h"
+#include "output/output_file.h"
 #include "sim/mujoco_messages.h"
 #include "sim/scene_fields.h"
 
@@ -42,7 +42,7 @@ void require_scene_file(const std::string& path) {
   }
   if (!S_ISREG(st.st_mode)) {
     throw SimError(path + ": not a scene file (" +
-                   report::file_kind(st.st_mode) + ")");
+                   output::file_kind(st.st_mode) + ")");
   }
   if (!std::ifstream(path).good()) {
     throw SimError(path + ": cannot open the scene file");
@@ -77,12 +77,12 @@ void check_scene_bounds(const std::string& path) {
       if (::stat(p.c_str(), &st) != 0) continue;  // MuJoCo names a missing one
       if (!S_ISREG(st.st_mode)) {
         throw SimError(path + ": asset '" + asset + "' (" + p.string() + ") is " +
-                       report::file_kind(st.st_mode) + ", not a regular file");
+                       output::file_kind(st.st_mode) + ", not a regular file");
       }
       if (static_cast<std::uint64_t>(st.st_size) > kMaxAssetBytes) {
         throw SimError(path + ": asset '" + asset + "' is " +
-                       report::bytes_text(static_cast<std::uint64_t>(st.st_size)) +
-                       ", over the bound of " + report::bytes_text(kMaxAssetBytes));
+                       output::bytes_text(static_cast<std::uint64_t>(st.st_size)) +
+                       ", over the bound of " + output::bytes_text(kMaxAssetBytes));
       }
     }
   }
@@ -102,7 +102,7 @@ ModelPtr load_locked(const std::string& path, const mjVFS* vfs = nullptr) {
 std::string slurp(const std::string& path) {
   bool missing = false;
   try {
-    std::string text = report::read_regular_file(path, kMaxSceneBytes, &missing);
+    std::string text = output::read_regular_file(path, kMaxSceneBytes, &missing);
     if (!missing) return text;
   } catch (const std::runtime_error& e) {
     throw SimError(e.what());

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "report/output_file.h"
+#include "output/output_file.h"
 
 namespace vmh::sim {
 namespace {
@@ -58,12 +58,12 @@ class SceneReader {
     bool missing = false;
     std::string text;
     try {
-      text = report::read_regular_file(path, kMaxSceneBytes - census.bytes, &missing);
+      text = output::read_regular_file(path, kMaxSceneBytes - census.bytes, &missing);
     } catch (const std::runtime_error& e) {
       const bool size = std::string(e.what()).find("bound") != std::string::npos;
       throw ParamError(std::string(e.what()) +
                        (size && census.bytes > 0 ? " (a scene's files together are at most " +
-                                               report::bytes_text(kMaxSceneBytes) + ")"
+                                               output::bytes_text(kMaxSceneBytes) + ")"
                                          : std::string()));
     }
     if (missing) throw ParamError(path + ": no such file");

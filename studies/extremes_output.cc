@@ -1,14 +1,14 @@
 // The extreme-cases study's outputs: the JSON the command line prints and
 // extremes.json holds, the tables (CSV, units in the column names) and the
-// figure of the passivity observer, one panel per scenario (report/'s chart).
+// figure of the passivity observer, one panel per scenario (output/'s chart).
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include "report/output_file.h"
-#include "report/svg_chart.h"
+#include "output/output_file.h"
+#include "output/svg_chart.h"
 #include "studies/extremes_study.h"
 
 namespace vmh::studies {
@@ -44,10 +44,10 @@ const char* outcome_colour(const std::string& outcome) {
 
 // one scenario's panel: E(t) in mJ, zero and the end of the script dashed,
 // the judged window shaded
-report::Chart energy_panel(const ExtremeResult& r, const EnergyCurve& e) {
+output::Chart energy_panel(const ExtremeResult& r, const EnergyCurve& e) {
   const double t_end_s = r.simulated_s > 0.0 ? r.simulated_s : 1.0;
   const double script_end_s = t_end_s - kExtremeRestS;
-  report::Chart c;
+  output::Chart c;
   c.title = r.scenario.name;
   c.subtitle = r.outcome;
   c.subtitle_color = outcome_colour(r.outcome);
@@ -55,7 +55,7 @@ report::Chart energy_panel(const ExtremeResult& r, const EnergyCurve& e) {
   c.height_px = 210;
   c.x = {"t (s)", false, 0.0, t_end_s};
   c.y = {"E (mJ)", false};
-  report::ChartSeries curve;
+  output::ChartSeries curve;
   curve.color = "#1565c0";
   curve.markers = false;
   double lo_mJ = 0.0, hi_mJ = 0.0;  // zero always shows
@@ -65,8 +65,8 @@ report::Chart energy_panel(const ExtremeResult& r, const EnergyCurve& e) {
     lo_mJ = std::min(lo_mJ, curve.y.back());
     hi_mJ = std::max(hi_mJ, curve.y.back());
   }
-  report::ChartSeries zero, script_end;
-  for (report::ChartSeries* s : {&zero, &script_end}) {
+  output::ChartSeries zero, script_end;
+  for (output::ChartSeries* s : {&zero, &script_end}) {
     s->color = "#999999";
     s->markers = false;
     s->dashed = true;
@@ -240,8 +240,8 @@ EnergyCurve thin_energy(const std::vector<TickRecord>& rows, std::size_t buckets
   return e;
 }
 
-report::ChartGrid extremes_figure(const ExtremesResult& r) {
-  report::ChartGrid g;
+output::ChartGrid extremes_figure(const ExtremesResult& r) {
+  output::ChartGrid g;
   g.title = "Extreme cases: the passivity observer E(t), energy the motors "
             "put into the device (mJ)";
   char note[240];
@@ -280,12 +280,12 @@ nlohmann::json extremes_json(const ExtremesResult& r) {
 
 void write_extremes_files(const ExtremesResult& r, const std::string& out_dir) {
   const fs::path dir(out_dir);
-  report::write_file_atomically((dir / "extremes.csv").string(),
+  output::write_file_atomically((dir / "extremes.csv").string(),
                                 extremes_csv(r.scenarios));
-  report::write_file_atomically((dir / "extremes.json").string(),
+  output::write_file_atomically((dir / "extremes.json").string(),
                                 extremes_json(r).dump(2) + "\n");
-  report::write_file_atomically((dir / "extremes.svg").string(),
-                                report::chart_grid_svg(extremes_figure(r)));
+  output::write_file_atomically((dir / "extremes.svg").string(),
+                                output::chart_grid_svg(extremes_figure(r)));
 }
 
 }  // namespace vmh::studies

@@ -12,8 +12,8 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
-#include "report/output_file.h"
-#include "report/parallel.h"
+#include "output/output_file.h"
+#include "output/parallel.h"
 #include "studies/run_case.h"
 
 namespace vmh::studies {
@@ -486,12 +486,12 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
       if (!keep && !dir.empty()) fs::remove(dir, ignored);  // only if empty
     }
   } made_here;
-  std::unique_ptr<report::OutputSet> series;
+  std::unique_ptr<output::OutputSet> series;
   if (!o.out_dir.empty()) {
     std::error_code ec;
     if (!fs::exists(o.out_dir, ec)) made_here.dir = o.out_dir;
     try {
-      series = std::make_unique<report::OutputSet>(
+      series = std::make_unique<output::OutputSet>(
           (fs::path(o.out_dir) / "extremes").string());
     } catch (const std::runtime_error& e) {
       throw SimError(o.out_dir + ": " + e.what());
@@ -507,7 +507,7 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   std::atomic<std::size_t> finished{0};
   std::atomic<bool> stopped{false};
-  report::parallel_for(table.size(), o.jobs, [&](std::size_t i) {
+  output::parallel_for(table.size(), o.jobs, [&](std::size_t i) {
     // once stopped, the scenarios not begun are skipped
     if (stopped || stop_asked(o.should_stop)) {
       stopped = true;

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "report/svg_chart.h"
+#include "output/svg_chart.h"
 #include "sim/closed_loop.h"
 #include "studies/stop.h"
 
@@ -203,7 +203,7 @@ struct ExtremesResult {
 // observer's E(t), one panel per scenario) and out_dir/extremes/<name>.csv
 // (a time series per scenario). Throws SimError naming the scenario on bad
 // input. The series go into a private folder beside out_dir/extremes as
-// they are made (report::OutputSet) and replace that folder whole at the
+// they are made (output::OutputSet) and replace that folder whole at the
 // end, just before the three files: should_stop (polled last before that)
 // throws Interrupted with nothing written and no folder of its own left,
 // and out_dir/extremes then holds only the series of the scenarios run.
@@ -228,7 +228,7 @@ EnergyCurve thin_energy(const std::vector<TickRecord>& rows,
 // the figure: one panel per scenario, E(t) in mJ over the whole run, the
 // end of the script dashed, the rest window the study judges shaded, the
 // outcome under the name in its colour
-report::ChartGrid extremes_figure(const ExtremesResult& r);
+output::ChartGrid extremes_figure(const ExtremesResult& r);
 // writes the study's files under out_dir (not the per-scenario series)
 void write_extremes_files(const ExtremesResult& r, const std::string& out_dir);
 

@@ -8,15 +8,15 @@
 #include <stdexcept>
 #include <utility>
 
-#include "report/svg_text.h"
+#include "output/svg_text.h"
 
 namespace vmh::studies {
 namespace {
 
-using report::svg::attr;
-using report::svg::escape;
-using report::svg::format;
-using report::svg::px;
+using output::svg::attr;
+using output::svg::escape;
+using output::svg::format;
+using output::svg::px;
 
 constexpr double kPanel_px = 360.0;   // each panel's square plot area
 constexpr double kMargin_px = 48.0;
@@ -78,7 +78,7 @@ std::string panel(const std::vector<ForceSample>& s,
        " text-anchor=\"middle\">" +
        escape(std::string(axis_name(v.up)) + " (mm)") + "</text>\n";
   // ticks in mm on both axes, at a step giving about five of them
-  const double step = report::svg::nice_step(span, 5.0);
+  const double step = output::svg::nice_step(span, 5.0);
   for (int axis = 0; axis < 2; ++axis) {
     const double c = axis == 0 ? c0 : c1;
     for (double t = std::ceil((c - span / 2) / step) * step; t <= c + span / 2;

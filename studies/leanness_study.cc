@@ -11,7 +11,7 @@
 #include "controller/controller.h"
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
-#include "report/output_file.h"
+#include "output/output_file.h"
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
 
@@ -319,7 +319,7 @@ LeannessResult run_leanness_study(const LeannessOptions& o) {
   // the last poll: from here leanness.csv goes in
   throw_if_stop_asked(o.should_stop);
   if (!o.out_dir.empty()) {
-    result.files = {report::write_file_in(o.out_dir, "leanness.csv",
+    result.files = {output::write_file_in(o.out_dir, "leanness.csv",
                                           leanness_csv(result))};
   }
   return result;

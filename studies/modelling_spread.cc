@@ -70,10 +70,10 @@ nlohmann::ordered_json modelling_spread_json(const ModellingSpread& s,
           {"dominant", dominant}};
 }
 
-void add_modelling_spread(report::Chart* chart, const ModellingSpread& s) {
+void add_modelling_spread(output::Chart* chart, const ModellingSpread& s) {
   if (!s.present || !(s.spread_mm > 0.0)) return;
   double lo = INFINITY, hi = -INFINITY;
-  for (const report::ChartSeries& series : chart->series) {
+  for (const output::ChartSeries& series : chart->series) {
     for (double x : series.x) {
       if (!std::isfinite(x) || x <= 0.0) continue;
       lo = std::min(lo, x);
@@ -81,7 +81,7 @@ void add_modelling_spread(report::Chart* chart, const ModellingSpread& s) {
     }
   }
   if (!(lo <= hi)) return;
-  report::ChartSeries line;
+  output::ChartSeries line;
   char label[160];
   std::snprintf(label, sizeof label,
                 "modelling spread of the RMS path error, %s (%.3g mm)",

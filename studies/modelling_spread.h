@@ -14,7 +14,7 @@
 
 #include <string>
 
-#include "report/svg_chart.h"
+#include "output/svg_chart.h"
 
 namespace vmh::studies {
 
@@ -44,7 +44,7 @@ nlohmann::ordered_json modelling_spread_json(const ModellingSpread& s,
 
 // A horizontal dashed line at the spread across the chart's x range (the
 // span of its series).
-void add_modelling_spread(report::Chart* chart, const ModellingSpread& s);
+void add_modelling_spread(output::Chart* chart, const ModellingSpread& s);
 
 }  // namespace vmh::studies
 

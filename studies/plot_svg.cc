@@ -10,18 +10,18 @@
 #include <utility>
 #include <vector>
 
-#include "report/svg_text.h"
+#include "output/svg_text.h"
 
 namespace vmh::studies {
 // the testbed's types (sim/) by their own names in this file
 using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
-using report::svg::attr;
-using report::svg::escape;
-using report::svg::format;
-using report::svg::nice_step;
-using report::svg::px;
+using output::svg::attr;
+using output::svg::escape;
+using output::svg::format;
+using output::svg::nice_step;
+using output::svg::px;
 
 using Pt = std::pair<double, double>;
 

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <string>
 
-#include "report/output_file.h"
-#include "report/svg_chart.h"
+#include "output/output_file.h"
+#include "output/svg_chart.h"
 #include "studies/precision_study.h"
 
 namespace vmh::studies {
@@ -147,11 +147,11 @@ nlohmann::ordered_json precision_json(const PrecisionResult& r) {
 
 std::vector<std::string> write_precision_files(const PrecisionResult& r,
                                                const std::string& out_dir) {
-  return {report::write_file_in(out_dir, "precision.csv", precision_csv(r)),
-          report::write_file_in(out_dir, "precision.svg",
-                                report::chart_svg(precision_chart(r))),
-          report::write_file_in(out_dir, "precision_order.svg",
-                                report::chart_svg(precision_order_chart(r)))};
+  return {output::write_file_in(out_dir, "precision.csv", precision_csv(r)),
+          output::write_file_in(out_dir, "precision.svg",
+                                output::chart_svg(precision_chart(r))),
+          output::write_file_in(out_dir, "precision_order.svg",
+                                output::chart_svg(precision_order_chart(r)))};
 }
 
 }  // namespace vmh::studies

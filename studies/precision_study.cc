@@ -202,8 +202,8 @@ const char* colour_of(Integrator i) {
 // hides another: euler (drawn first) has a wide line and large dots,
 // implicit (drawn over it) a thin dotted line and rings through which
 // euler's dots show.
-report::SeriesLook look_of(Integrator i) {
-  report::SeriesLook look;
+output::SeriesLook look_of(Integrator i) {
+  output::SeriesLook look;
   if (i == Integrator::kEuler) {
     look.line_width = 3.5;
     look.marker_radius = 5.0;
@@ -540,8 +540,8 @@ std::string precision_csv(const PrecisionResult& r) {
   return s;
 }
 
-report::Chart precision_chart(const PrecisionResult& r) {
-  report::Chart c;
+output::Chart precision_chart(const PrecisionResult& r) {
+  output::Chart c;
   char title[160];
   // centred on the plot area, so kept short
   std::snprintf(title, sizeof title, "work-precision, %.3g s, T = %.3g ms",
@@ -553,7 +553,7 @@ report::Chart precision_chart(const PrecisionResult& r) {
   c.x = {"wall time of the run (s)", true};
   c.y = {"RMS wrist-centre error vs RK4 reference (mm)", true};
   for (const OrderFit& f : r.fits) {
-    report::ChartSeries s;
+    output::ChartSeries s;
     s.label = integrator_name(f.integrator);
     s.color = colour_of(f.integrator);
     for (const PrecisionRow& row : r.rows) {
@@ -567,7 +567,7 @@ report::Chart precision_chart(const PrecisionResult& r) {
   }
   for (const PrecisionRow& row : r.rows) {
     if (!row.is_default || !row.error.finite) continue;
-    report::ChartSeries s;
+    output::ChartSeries s;
     char label[96];
     std::snprintf(label, sizeof label, "default (%s, h = %.3g ms)",
                   integrator_name(row.integrator), row.step_s * 1e3);
@@ -585,7 +585,7 @@ report::Chart precision_chart(const PrecisionResult& r) {
       lo = std::min(lo, row.wall_time_s);
       hi = std::max(hi, row.wall_time_s);
     }
-    report::ChartSeries s;
+    output::ChartSeries s;
     s.label = "reference self-error (RK4 " +
               exact(r.reference.check_step_s * 1e6) + " us vs " +
               exact(r.reference.step_s * 1e6) + " us)";
@@ -600,8 +600,8 @@ report::Chart precision_chart(const PrecisionResult& r) {
   return c;
 }
 
-report::Chart precision_order_chart(const PrecisionResult& r) {
-  report::Chart c;
+output::Chart precision_order_chart(const PrecisionResult& r) {
+  output::Chart c;
   c.title = "error against the physics step";
   c.subtitle = coincide_note(r);
   c.width_px = 820;
@@ -609,7 +609,7 @@ report::Chart precision_order_chart(const PrecisionResult& r) {
   c.x = {"physics step h (s)", true};
   c.y = {"RMS wrist-centre error vs RK4 reference (mm)", true};
   for (const OrderFit& f : r.fits) {
-    report::ChartSeries s;
+    output::ChartSeries s;
     s.color = colour_of(f.integrator);
     s.label = integrator_name(f.integrator);
     for (const PrecisionRow& row : r.rows) {
@@ -621,7 +621,7 @@ report::Chart precision_order_chart(const PrecisionResult& r) {
     c.looks.resize(c.series.size());
     c.looks.back() = look_of(f.integrator);
     if (f.points >= 2) {
-      report::ChartSeries line;
+      output::ChartSeries line;
       char label[96];
       std::snprintf(label, sizeof label, "%s fit, order %.2f",
                     integrator_name(f.integrator), f.order);
@@ -640,7 +640,7 @@ report::Chart precision_order_chart(const PrecisionResult& r) {
     }
   }
   if (r.floor_mm > 0.0 && !r.rows.empty()) {
-    report::ChartSeries s;
+    output::ChartSeries s;
     s.label = "fit floor (10 x reference self-error)";
     s.color = "#7f7f7f";
     s.markers = false;

@@ -28,8 +28,8 @@
 
 #include "controller/types.h"
 #include "sim/hand_script.h"
-#include "report/progress.h"
-#include "report/svg_chart.h"
+#include "output/progress.h"
+#include "output/svg_chart.h"
 #include "studies/modelling_spread.h"
 #include "studies/stop.h"
 
@@ -68,7 +68,7 @@ struct PrecisionOptions {
   std::string out_dir;
   // called with (runs done, runs) after the references (one item) and after
   // each rung of the ladder; not set: nothing
-  report::ProgressFn progress;
+  output::ProgressFn progress;
   // polled between the runs and every 64 ticks of each (both references'
   // threads too), and last before the files are written (studies/stop.h);
   // not set: never stops
@@ -175,9 +175,9 @@ std::vector<bool> pareto_front(const std::vector<double>& x,
 std::string precision_csv(const PrecisionResult& r);
 // error (RMS, mm) against wall time (s), log-log, one line per integrator,
 // the default setting and the reference marked
-report::Chart precision_chart(const PrecisionResult& r);
+output::Chart precision_chart(const PrecisionResult& r);
 // error (RMS, mm) against h (s), log-log, with the fitted slopes
-report::Chart precision_order_chart(const PrecisionResult& r);
+output::Chart precision_order_chart(const PrecisionResult& r);
 
 // (precision_output.cc) What the command line prints: the setting, the
 // reference, the fitted orders, the default setting against the others,

@@ -9,16 +9,16 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "report/output_file.h"
+#include "output/output_file.h"
 
-#include "report/svg_text.h"
+#include "output/svg_text.h"
 #include "studies/force_field_svg.h"
 #include "studies/thesis_svg.h"
 
 namespace vmh::studies {
 namespace {
 
-using report::svg::escape;
+using output::svg::escape;
 using PageJson = nlohmann::json;
 
 // a number as a reader reads it: 4 significant digits, integers whole
@@ -421,7 +421,7 @@ std::string read_file_text(const std::string& path) {
   // without blocking and within a bound (a FIFO or /dev/zero in its place
   // is refused, not waited on or read for ever)
   bool missing = false;
-  std::string text = report::read_regular_file(path, kMaxReusedFileBytes, &missing);
+  std::string text = output::read_regular_file(path, kMaxReusedFileBytes, &missing);
   return missing ? std::string() : text;
 }
 

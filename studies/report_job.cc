@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "device/stop_signal.h"
-#include "report/output_file.h"
-#include "report/parallel.h"
-#include "report/progress.h"
+#include "output/output_file.h"
+#include "output/parallel.h"
+#include "output/progress.h"
 #include "runtime/stop.h"
 #include "sim/case_catalogue.h"
 #include "studies/extremes_study.h"
@@ -141,7 +141,7 @@ void rj_run(const ReportJob& job, RjPlan* plan, const fs::path& dir,
             const PrecisionOptions& precision, const StabilityOptions& map,
             const std::string& kept) {
   // one bar over the whole job; each study corrects its part's estimate
-  report::Progress bar("report", 0);
+  output::Progress bar("report", 0);
   const std::size_t p_cases = bar.add_part(plan->cases.size());
   const std::size_t p_ex =
       bar.add_part(plan->extremes ? extreme_scenarios().size() : 0);
@@ -240,9 +240,9 @@ ReportOutcome make_report(const ReportJob& job) {
     // the force field and the thesis's figures exist only here: kept beside
     // the case's other SVGs, so that they can be opened (and compared)
     // standalone
-    report::write_file_in((dir / c.name).string(), "force_field.svg",
+    output::write_file_in((dir / c.name).string(), "force_field.svg",
                           in.cases.back().force_field_svg);
-    report::write_file_in((dir / c.name).string(), "thesis.svg",
+    output::write_file_in((dir / c.name).string(), "thesis.svg",
                           in.cases.back().thesis_svg);
   }
   in.studies = rj_studies(study_dir, precision, map);
@@ -252,14 +252,14 @@ ReportOutcome make_report(const ReportJob& job) {
   h.git_describe = job.git_describe;
   h.generated_utc = job.generated_utc;
   h.command_line = job.command_line;
-  h.cores = report::core_count();
+  h.cores = output::core_count();
   h.reused = plan.reused;
   h.ran = plan.ran;
   h.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string html = report_html(in);
   runtime::throw_if_stopped("report", kept);
   ReportOutcome out;
-  out.page = report::write_file_in(dir.string(), "report.html", html);
+  out.page = output::write_file_in(dir.string(), "report.html", html);
   // a signal while the page went in: it is whole, and the exit says so
   runtime::throw_if_stopped("report", "; " + out.page + " was already written whole");
 

@@ -15,8 +15,8 @@
 #include <mutex>
 
 #include "controller/device_frame.h"
-#include "report/output_file.h"
-#include "report/parallel.h"
+#include "output/output_file.h"
+#include "output/parallel.h"
 #include "runtime/trace_writer.h"
 #include "sim/mujoco_messages.h"
 #include "studies/plot_svg.h"
@@ -254,7 +254,7 @@ class CaseWork {
     // then); trace.csv is written into it as the run goes
     if (!out_dir.empty()) {
       check_space_for_trace(out_dir, *loop_);
-      set_ = std::make_unique<report::OutputSet>((fs::path(out_dir) / name).string());
+      set_ = std::make_unique<output::OutputSet>((fs::path(out_dir) / name).string());
       trace_ = std::make_unique<runtime::TraceWriter>(
           (fs::path(set_->temp_dir()) / "trace.csv").string(),
           (fs::path(out_dir) / name / "trace.csv").string(), trace_layout(*loop_));
@@ -518,7 +518,7 @@ class CaseWork {
   ModelPtr compiled_;  // compiled once; the main run and every side copy it
   std::unique_ptr<ClosedLoop> loop_;  // the main run's
   int thesis_case_ = 0;
-  std::unique_ptr<report::OutputSet> set_;
+  std::unique_ptr<output::OutputSet> set_;
   std::unique_ptr<runtime::TraceWriter> trace_;
   SideLabel first_label_;
   std::vector<Claim> window_claims_;
@@ -550,9 +550,9 @@ void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
                const std::string& out_dir, int threads,
                const std::string& model_file,
-               const report::ProgressFn& progress, const StopFn& stop,
+               const output::ProgressFn& progress, const StopFn& stop,
                const CaseRunOptions& options) {
-  const int n_threads = threads > 0 ? threads : report::core_count();
+  const int n_threads = threads > 0 ? threads : output::core_count();
   const auto record = [](CaseJob* job, const auto& body) {
     try {
       body();
@@ -568,7 +568,7 @@ void run_cases(std::vector<CaseJob>* jobs,
   };
   // each case loaded and checked (bad input ends that case here)
   std::vector<std::unique_ptr<CaseWork>> work(jobs->size());
-  report::parallel_for(jobs->size(), n_threads, [&](std::size_t i) {
+  output::parallel_for(jobs->size(), n_threads, [&](std::size_t i) {
     CaseJob& job = (*jobs)[i];
     record(&job, [&] {
       work[i] = CaseWork::load(job.name, job.scene, overrides, out_dir,
@@ -589,7 +589,7 @@ void run_cases(std::vector<CaseJob>* jobs,
   for (const auto& w : work) {
     if (!w && progress) progress(++finished, jobs->size());
   }
-  report::parallel_for(runs.size(), n_threads, [&](std::size_t k) {
+  output::parallel_for(runs.size(), n_threads, [&](std::size_t k) {
     const std::size_t c = runs[k].first;
     const auto r = runs[k].second;
     if (!work[c]->run(r, stop)) return;

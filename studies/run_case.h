@@ -1,7 +1,7 @@
 // Runs a case from start to end and writes its outputs: DIR/<case>/trace.csv
 // (one row per servo tick), DIR/<case>/summary.json (metrics and the
 // thesis's claims), and the plots views.svg and history.svg (plot_svg.h).
-// The four are written as one set (report::OutputSet): into a private
+// The four are written as one set (output::OutputSet): into a private
 // temporary folder beside DIR/<case>, renamed into place once all are
 // complete, so a failed or interrupted run leaves the previous set (or
 // none) and nothing half-written. docs/outputs.md documents the formats.
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "report/progress.h"
+#include "output/progress.h"
 #include "sim/mujoco_messages.h"
 #include "sim/case_catalogue.h"
 #include "sim/closed_loop.h"
@@ -102,7 +102,7 @@ void run_cases(std::vector<CaseJob>* jobs,
                const std::vector<std::string>& overrides,
                const std::string& out_dir, int threads,
                const std::string& model_file = "",
-               const report::ProgressFn& progress = {},
+               const output::ProgressFn& progress = {},
                const StopFn& stop = {},
                const CaseRunOptions& options = {});
 

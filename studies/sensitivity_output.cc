@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "report/output_file.h"
+#include "output/output_file.h"
 #include "studies/sensitivity_study.h"
 
 namespace vmh::studies {
@@ -413,9 +413,9 @@ std::string sensitivity_csv(const SweepPlan& plan,
   return s.str();
 }
 
-report::ChartGrid sensitivity_chart(const SweepPlan& plan,
+output::ChartGrid sensitivity_chart(const SweepPlan& plan,
                                     const std::vector<PointResult>& results) {
-  report::ChartGrid grid;
+  output::ChartGrid grid;
   grid.title = "Sensitivity: each claim's margin over each parameter's range, "
                "the others nominal";
   grid.notes = {
@@ -427,7 +427,7 @@ report::ChartGrid sensitivity_chart(const SweepPlan& plan,
   for (std::size_t ci = 0; ci < plan.cases.size(); ++ci) {
     const CasePoints cp = case_points(plan, ci);
     for (const ClaimView& cv : case_claims(plan, ci, results)) {
-      report::Chart ch;
+      output::Chart ch;
       ch.title = plan.cases[ci].name + " " + cv.name;
       ch.x.label = "parameter (legend order)";
       ch.y.label = "claim margin (relative)";
@@ -443,14 +443,14 @@ report::ChartGrid sensitivity_chart(const SweepPlan& plan,
             r.add(claim_margin(*o));
           }
         }
-        report::ChartSeries s;
+        output::ChartSeries s;
         s.label = plan.parameters[j].name;
         const double x = static_cast<double>(j + 1);
         s.x = {x, x};
         s.y = {r.lo, r.hi};
         ch.series.push_back(s);
       }
-      report::ChartSeries zero;
+      output::ChartSeries zero;
       zero.label = "holds above 0";
       zero.x = {0.5, static_cast<double>(plan.parameters.size()) + 0.5};
       zero.y = {0.0, 0.0};
@@ -458,7 +458,7 @@ report::ChartGrid sensitivity_chart(const SweepPlan& plan,
       zero.dashed = true;
       zero.markers = false;
       ch.series.push_back(zero);
-      report::ChartSeries nom;
+      output::ChartSeries nom;
       nom.label = "nominal";
       for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
         nom.x.push_back(static_cast<double>(j + 1));
@@ -476,12 +476,12 @@ report::ChartGrid sensitivity_chart(const SweepPlan& plan,
 std::vector<std::string> write_sensitivity_files(
     const SweepPlan& plan, const std::vector<PointResult>& results,
     const std::string& out_dir) {
-  const std::string svg = report::chart_grid_svg(sensitivity_chart(plan, results));
-  return {report::write_file_in(out_dir, "sensitivity.json",
+  const std::string svg = output::chart_grid_svg(sensitivity_chart(plan, results));
+  return {output::write_file_in(out_dir, "sensitivity.json",
                                 sensitivity_json(plan, results).dump(2) + "\n"),
-          report::write_file_in(out_dir, "sensitivity.csv",
+          output::write_file_in(out_dir, "sensitivity.csv",
                                 sensitivity_csv(plan, results)),
-          report::write_file_in(out_dir, "sensitivity.svg", svg)};
+          output::write_file_in(out_dir, "sensitivity.svg", svg)};
 }
 
 nlohmann::ordered_json partial_json(const SweepPlan& plan, int k, int n,
@@ -524,7 +524,7 @@ nlohmann::ordered_json partial_json(const SweepPlan& plan, int k, int n,
 std::string write_partial_file(const SweepPlan& plan, int k, int n,
                                const std::vector<PointResult>& results,
                                const std::string& out_dir) {
-  return report::write_file_in(out_dir, "sensitivity.partial.json",
+  return output::write_file_in(out_dir, "sensitivity.partial.json",
                                partial_json(plan, k, n, results).dump(2) + "\n");
 }
 

@@ -10,7 +10,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "report/parallel.h"
+#include "output/parallel.h"
 #include "sim/case.h"
 #include "sim/case_params.h"
 #include "sim/closed_loop.h"
@@ -491,7 +491,7 @@ PointResult run_point(const SweepPlan& plan, std::size_t index,
 std::vector<PointResult> run_points(const SweepPlan& plan,
                                     const std::vector<std::size_t>& which,
                                     int jobs,
-                                    const report::ProgressFn& progress,
+                                    const output::ProgressFn& progress,
                                     const StopFn& stop) {
   std::vector<std::size_t> list = which;
   if (list.empty()) {
@@ -500,7 +500,7 @@ std::vector<PointResult> run_points(const SweepPlan& plan,
   std::vector<PointResult> out(list.size());
   std::atomic<std::size_t> done{0};
   std::atomic<bool> stopped{false};
-  report::parallel_for(list.size(), jobs > 0 ? jobs : report::core_count(),
+  output::parallel_for(list.size(), jobs > 0 ? jobs : output::core_count(),
                        [&](std::size_t i) {
                          if (stopped || stop_asked(stop)) {
                            stopped = true;

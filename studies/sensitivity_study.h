@@ -33,8 +33,8 @@
 #include <string>
 #include <vector>
 
-#include "report/progress.h"
-#include "report/svg_chart.h"
+#include "output/progress.h"
+#include "output/svg_chart.h"
 #include "sim/mujoco_util.h"
 #include "studies/stop.h"
 
@@ -166,7 +166,7 @@ PointResult run_point(const SweepPlan& plan, std::size_t index,
 std::vector<PointResult> run_points(const SweepPlan& plan,
                                     const std::vector<std::size_t>& which,
                                     int jobs,
-                                    const report::ProgressFn& progress = {},
+                                    const output::ProgressFn& progress = {},
                                     const StopFn& stop = {});
 
 // The claim's margin: value - threshold for ">=", threshold - value for
@@ -183,7 +183,7 @@ std::string sensitivity_csv(const SweepPlan& plan,
                             const std::vector<PointResult>& results);
 // per claim, the span of its margin over each parameter's one-at-a-time
 // sweep, zero where it stops holding
-report::ChartGrid sensitivity_chart(const SweepPlan& plan,
+output::ChartGrid sensitivity_chart(const SweepPlan& plan,
                                     const std::vector<PointResult>& results);
 
 // out_dir/sensitivity.json, .csv and .svg; returns their paths

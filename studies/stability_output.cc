@@ -1,5 +1,5 @@
 // The stability study's outputs: the bisection's runs and the map as
-// tables (CSV, units in the column names) and charts (report/'s chart), and
+// tables (CSV, units in the column names) and charts (output/'s chart), and
 // the JSON the command line prints (keys in the order a reader meets them).
 #include <algorithm>
 #include <cmath>
@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "report/output_file.h"
-#include "report/svg_chart.h"
+#include "output/output_file.h"
+#include "output/svg_chart.h"
 #include "studies/stability_study.h"
 
 namespace vmh::studies {
@@ -132,8 +132,8 @@ std::string bisection_csv(const StabilityReport& r) {
   return s;
 }
 
-report::Chart bisection_chart(const StabilityReport& r) {
-  report::Chart c;
+output::Chart bisection_chart(const StabilityReport& r) {
+  output::Chart c;
   char title[200];
   std::snprintf(title, sizeof title,
                 "Bisection on K: m = %g kg, b = %g N s/m, T = %g ms, B = %g "
@@ -145,7 +145,7 @@ report::Chart bisection_chart(const StabilityReport& r) {
   c.x.label = "stiffness K (N/m)";
   c.y.label = "envelope growth rate (1/s)";
   c.width_px = 820;
-  report::ChartSeries runs;
+  output::ChartSeries runs;
   runs.label = "simulated runs";
   runs.line = false;
   double lo = 0.0, hi = 0.0;
@@ -159,7 +159,7 @@ report::Chart bisection_chart(const StabilityReport& r) {
   c.series.push_back(runs);
   auto vertical = [&](const std::string& label, double k, const char* color,
                       bool dashed) {
-    report::ChartSeries s;
+    output::ChartSeries s;
     s.label = label;
     s.x = {k, k};
     s.y = {lo, hi};
@@ -208,7 +208,7 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
       delays.push_back(p.delay_ticks);
     }
   }
-  report::Chart c;
+  output::Chart c;
   char title[256];
   std::snprintf(title, sizeof title,
                 "K_crit of the sampled wall: m = %g kg, b = %g N s/m, "
@@ -225,7 +225,7 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
     const int n = delays[i];
     const std::string color = kColors[i % (sizeof kColors / sizeof *kColors)];
     const std::string tag = "n = " + std::to_string(n);
-    report::ChartSeries sim, exact, gil;
+    output::ChartSeries sim, exact, gil;
     sim.label = "simulated, " + tag;
     sim.line = false;
     exact.label = "exact discrete, " + tag;
@@ -248,7 +248,7 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
     c.series.push_back(exact);
     c.series.push_back(gil);
   }
-  report::ChartSeries passive;
+  output::ChartSeries passive;
   passive.label = "passivity 2(b-B)/T (Colgate & Schenkel)";
   passive.markers = false;
   passive.dashed = true;
@@ -274,7 +274,7 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
   // under the first markers, so a legend entry would name a line no one can
   // see. Then the subtitle gives its end points instead.
   double K_max = 0.0;
-  for (const report::ChartSeries& s : c.series) {
+  for (const output::ChartSeries& s : c.series) {
     for (double k : s.y) K_max = std::max(K_max, k);
   }
   double x_span = 0.0, y_span = 0.0;
@@ -297,7 +297,7 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
                   2.0 * b / base.servo_period_s, b);
     c.subtitle = note;
   }
-  return report::chart_svg(c);
+  return output::chart_svg(c);
 }
 
 nlohmann::ordered_json stability_json(const StabilityResult& r) {
@@ -307,15 +307,15 @@ nlohmann::ordered_json stability_json(const StabilityResult& r) {
 std::vector<std::string> write_stability_files(const StabilityResult& r,
                                                const std::string& out_dir) {
   if (r.is_map()) {
-    return {report::write_file_in(out_dir, "stability_map.csv",
+    return {output::write_file_in(out_dir, "stability_map.csv",
                                   stability_map_csv(r.map)),
-            report::write_file_in(out_dir, "stability_map.svg",
+            output::write_file_in(out_dir, "stability_map.svg",
                                   stability_map_svg(r.map, r.options.params))};
   }
-  return {report::write_file_in(out_dir, "stability_bisection.csv",
+  return {output::write_file_in(out_dir, "stability_bisection.csv",
                                 bisection_csv(r.bisection)),
-          report::write_file_in(out_dir, "stability_bisection.svg",
-                                report::chart_svg(bisection_chart(r.bisection)))};
+          output::write_file_in(out_dir, "stability_bisection.svg",
+                                output::chart_svg(bisection_chart(r.bisection)))};
 }
 
 }  // namespace vmh::studies

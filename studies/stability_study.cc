@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "report/parallel.h"
+#include "output/parallel.h"
 
 namespace vmh::studies {
 // the testbed's types (sim/) by their own names in this file
@@ -484,7 +484,7 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
   std::vector<std::exception_ptr> errors(points.size());
   std::atomic<std::size_t> finished{0};
   std::atomic<bool> stopped{false};
-  report::parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
+  output::parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
     // once stopped, the points not begun are skipped
     if (stopped || stop_asked(spec.should_stop)) {
       stopped = true;

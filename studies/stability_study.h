@@ -59,8 +59,8 @@
 #include <string>
 #include <vector>
 
-#include "report/progress.h"
-#include "report/svg_chart.h"
+#include "output/progress.h"
+#include "output/svg_chart.h"
 #include "sim/mujoco_util.h"
 #include "studies/stop.h"
 
@@ -250,7 +250,7 @@ struct MapSpec {
   double rel_tol = 2e-3;
   int jobs = 1;  // threads, each with its own model and data
   // called from the workers with (points done, points); not set: nothing
-  report::ProgressFn progress;
+  output::ProgressFn progress;
   // polled from the workers before each point and each run of its
   // bisection; once it says so no point starts and Interrupted is thrown
   StopFn should_stop;
@@ -283,7 +283,7 @@ struct StabilityOptions {
   std::vector<double> map_virtual_damping_Ns_per_m;
   std::vector<int> map_delay_ticks;
   int jobs = 1;  // map points simulated at once
-  report::ProgressFn progress;  // the map's (MapSpec::progress)
+  output::ProgressFn progress;  // the map's (MapSpec::progress)
   // polled before each run of a bisection (each point's, for a map) and
   // last before the files are written: Interrupted, nothing written
   StopFn should_stop;
@@ -317,7 +317,7 @@ nlohmann::ordered_json stability_json(const StabilityResult& r);
 // growth_rate_per_s, early_peak_m, late_peak_m, ticks.
 std::string bisection_csv(const StabilityReport& r);
 // their growth rates against K, the theories' K as vertical lines
-report::Chart bisection_chart(const StabilityReport& r);
+output::Chart bisection_chart(const StabilityReport& r);
 
 // The map as CSV, units in the column names: virtual_damping_Ns_per_m,
 // delay_ticks, k_crit_sim_N_per_m, k_stable_sim_N_per_m,
@@ -326,7 +326,7 @@ report::Chart bisection_chart(const StabilityReport& r);
 // rel_error_sim_vs_gil, sim_runs.
 std::string stability_map_csv(const std::vector<MapPoint>& points);
 
-// The map as an SVG chart (report/svg_chart.h): K_crit against B, for each
+// The map as an SVG chart (output/svg_chart.h): K_crit against B, for each
 // delay the simulated points as markers, the exact discrete boundary as a
 // line and Gil et al.'s bound dashed, with Colgate and Schenkel's passivity
 // bound dashed in grey (where it is > 0).

@@ -7,16 +7,16 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "report/svg_text.h"
+#include "output/svg_text.h"
 
 namespace vmh::studies {
 namespace {
 
-using report::svg::attr;
-using report::svg::escape;
-using report::svg::format;
-using report::svg::nice_step;
-using report::svg::px;
+using output::svg::attr;
+using output::svg::escape;
+using output::svg::format;
+using output::svg::nice_step;
+using output::svg::px;
 
 constexpr double kLeft_px = 64.0;
 constexpr double kTop_px = 52.0;

@@ -4,7 +4,7 @@
 
 #include <stdexcept>
 
-#include "report/output_file.h"
+#include "output/output_file.h"
 
 namespace vmh::viz {
 namespace {
@@ -87,7 +87,7 @@ void flip_rows(int width_px, int height_px, std::vector<std::uint8_t>* rgb) {
 
 void write_png(const std::string& path, int width_px, int height_px,
                const std::vector<std::uint8_t>& rgb) {
-  report::write_file_atomically(path, encode_png(width_px, height_px, rgb));
+  output::write_file_atomically(path, encode_png(width_px, height_px, rgb));
 }
 
 }  // namespace vmh::viz

@@ -20,7 +20,7 @@ std::string encode_png(int width_px, int height_px,
 // OpenGL reads rows from the bottom (mjr_readPixels): flips them in place.
 void flip_rows(int width_px, int height_px, std::vector<std::uint8_t>* rgb);
 
-// encode_png written atomically (report/output_file.h) to `path`.
+// encode_png written atomically (output/output_file.h) to `path`.
 void write_png(const std::string& path, int width_px, int height_px,
                const std::vector<std::uint8_t>& rgb);
 

@@ -10,7 +10,7 @@
 #include <filesystem>
 
 #include "controller/device_frame.h"
-#include "report/output_file.h"
+#include "output/output_file.h"
 #include "runtime/recording_reader.h"
 
 namespace vmh::hw::replay {
@@ -163,7 +163,7 @@ Recording read_recording(const std::string& folder, const RecordingLimits& limit
   if (!S_ISDIR(st.st_mode)) {
     throw RecordingError("replay: '" + folder + "' is " +
                          (S_ISREG(st.st_mode) ? std::string("a file")
-                                              : report::file_kind(st.st_mode)) +
+                                              : output::file_kind(st.st_mode)) +
                          ", not a folder; give the folder `vmhaptics hw "
                          "record --out DIR` wrote");
   }

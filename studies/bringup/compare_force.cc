@@ -10,8 +10,8 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_params.h"
-#include "report/output_file.h"
-#include "report/svg_chart.h"
+#include "output/output_file.h"
+#include "output/svg_chart.h"
 #include "studies/bringup/response_sim.h"
 #include "studies/run_case.h"
 
@@ -265,7 +265,7 @@ Hypothesis hypothesis(std::string name, double delay_s, double scale = 1.0) {
 void write_figure(const PulseWindow& w, const SimulatedResponse& nominal,
                   const Hypothesis* named, const std::string& dir,
                   CompareSection* s) {
-  report::ChartGrid g;
+  output::ChartGrid g;
   g.title = "force direction: motor " + std::to_string(w.motor) + " pulse, " +
             force_fmt(1e3 * w.pulse_s) + " ms";
   g.notes.push_back(
@@ -273,15 +273,15 @@ void write_figure(const PulseWindow& w, const SimulatedResponse& nominal,
       "time from the pulse's start (ms)");
   g.columns = 3;
   for (int c = 0; c < 3; ++c) {
-    report::Chart ch;
+    output::Chart ch;
     ch.title = "t" + std::to_string(c + 1);
     ch.x.label = "time from pulse start (ms)";
     ch.y.label = "t" + std::to_string(c + 1) + " (rad)";
     ch.bands.push_back({0.0, 1e3 * w.pulse_s, "#e8e8e8"});
-    report::ChartSeries meas{"measured", {}, {}, "#1f77b4", false, true, false};
-    report::ChartSeries pred{"predicted", {},    {},   "#d62728",
+    output::ChartSeries meas{"measured", {}, {}, "#1f77b4", false, true, false};
+    output::ChartSeries pred{"predicted", {},    {},   "#d62728",
                              true,        false, false};
-    report::ChartSeries hyp{
+    output::ChartSeries hyp{
         named ? named->name : "", {}, {}, "#2ca02c", true, false, true};
     for (std::size_t j = 0; j < nominal.t_s.size(); ++j) {
       const std::size_t i = w.sim_start + j;
@@ -301,9 +301,9 @@ void write_figure(const PulseWindow& w, const SimulatedResponse& nominal,
     if (named) ch.series.push_back(hyp);
     g.panels.push_back(ch);
   }
-  s->figures.push_back(report::write_file_in(
+  s->figures.push_back(output::write_file_in(
       dir, "force_direction_motor" + std::to_string(w.motor) + ".svg",
-      report::chart_grid_svg(g)));
+      output::chart_grid_svg(g)));
 }
 
 }  // namespace

@@ -9,8 +9,8 @@
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "controller/omni_params.h"
-#include "report/output_file.h"
-#include "report/svg_chart.h"
+#include "output/output_file.h"
+#include "output/svg_chart.h"
 
 namespace vmh::bringup {
 namespace {
@@ -182,7 +182,7 @@ CompareSection compare_jacobian(const Recording& rec, const ReadingMap& readings
   for (CompareCheck& c : sec.checks) c.recording = rec.dir;
 
   if (!figure_dir.empty() && !t_moving_s.empty()) {
-    report::Chart c;
+    output::Chart c;
     c.title = "Project J(q) qdot vs the device's velocity";
     c.subtitle = "recording " + rec.dir + ", device frame";
     c.x.label = "time (s)";
@@ -192,7 +192,7 @@ CompareSection compare_jacobian(const Recording& rec, const ReadingMap& readings
       c.series.push_back({"|dev_v|", t_moving_s, speed_device_mm_s, "", true, false, true});
     }
     sec.figures.push_back(
-        report::write_file_in(figure_dir, "jacobian_velocity.svg", report::chart_svg(c)));
+        output::write_file_in(figure_dir, "jacobian_velocity.svg", output::chart_svg(c)));
   }
   return sec;
 }

@@ -9,8 +9,8 @@
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "controller/omni_params.h"
-#include "report/output_file.h"
-#include "report/svg_chart.h"
+#include "output/output_file.h"
+#include "output/svg_chart.h"
 
 namespace vmh::bringup {
 namespace {
@@ -352,17 +352,17 @@ CompareSection compare_kinematics(const Recording& rec, const std::string& figur
   }
 
   if (!figure_dir.empty()) {
-    report::ChartGrid g;
+    output::ChartGrid g;
     g.title = "Project FK vs the device's transform";
     g.notes = {"recording " + rec.dir, "device frame; stylus axis vs the device's " + col_text};
-    report::Chart a;
+    output::Chart a;
     a.x.label = "time (s)";
     a.y.label = "wrist position error (mm)";
     a.series.push_back({"|p_FK - dev_p|", t_s, pos_err_mm, "", true, false, false});
     a.series.push_back({"p95 threshold", {t_s.front(), t_s.back()},
                         {kPositionErrorP95ThresholdMm, kPositionErrorP95ThresholdMm},
                         "#999999", true, false, true});
-    report::Chart b;
+    output::Chart b;
     b.x.label = "time (s)";
     b.y.label = "stylus axis error (deg)";
     b.series.push_back({"angle(z_FK, dev axis)", t_s, axis_err_deg, "", true, false, false});
@@ -371,7 +371,7 @@ CompareSection compare_kinematics(const Recording& rec, const std::string& figur
                         "#999999", true, false, true});
     g.panels = {a, b};
     sec.figures.push_back(
-        report::write_file_in(figure_dir, "kinematics_error.svg", report::chart_grid_svg(g)));
+        output::write_file_in(figure_dir, "kinematics_error.svg", output::chart_grid_svg(g)));
   }
   return sec;
 }

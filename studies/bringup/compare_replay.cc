@@ -6,8 +6,8 @@
 #include <stdexcept>
 
 #include "controller/controller.h"
-#include "report/output_file.h"
-#include "report/svg_chart.h"
+#include "output/output_file.h"
+#include "output/svg_chart.h"
 #include "sim/case.h"
 #include "sim/closed_loop.h"
 
@@ -99,7 +99,7 @@ CompareCheck ratio_check(const std::string& name, double value,
 
 void write_figure(const Series& rec, const Series& sim, const std::string& dir,
                   CompareSection* s) {
-  report::ChartGrid g;
+  output::ChartGrid g;
   g.title = "closed loop: recorded against the simulated scene";
   g.notes.push_back(
       "a real hand is not the scene's scripted hand: compare levels, not "
@@ -107,7 +107,7 @@ void write_figure(const Series& rec, const Series& sim, const std::string& dir,
   g.columns = 2;
   const char* what[2] = {"|e| position error (mm)", "|F| commanded force (N)"};
   for (int k = 0; k < 2; ++k) {
-    report::Chart ch;
+    output::Chart ch;
     ch.title = what[k];
     ch.x.label = "t (s)";
     ch.y.label = what[k];
@@ -118,7 +118,7 @@ void write_figure(const Series& rec, const Series& sim, const std::string& dir,
     g.panels.push_back(ch);
   }
   s->figures.push_back(
-      report::write_file_in(dir, "closed_loop.svg", report::chart_grid_svg(g)));
+      output::write_file_in(dir, "closed_loop.svg", output::chart_grid_svg(g)));
 }
 
 // (a) the replay; fills its check and detail

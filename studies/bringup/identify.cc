@@ -13,8 +13,8 @@
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "device/stop_signal.h"
-#include "report/output_file.h"
-#include "report/parallel.h"
+#include "output/output_file.h"
+#include "output/parallel.h"
 #include "runtime/stop.h"
 #include "sim/mujoco_util.h"
 #include "sim/sensor_model.h"
@@ -202,7 +202,7 @@ class Problem {
     std::vector<Eigen::VectorXd> out(edits.size(), Eigen::VectorXd::Zero(
                                                        static_cast<Eigen::Index>(size_)));
     const std::size_t nw = windows_.size();
-    report::parallel_for(edits.size() * nw, threads_, [&](std::size_t task) {
+    output::parallel_for(edits.size() * nw, threads_, [&](std::size_t task) {
       if (stop_requested()) return;  // thrown below, on this thread
       const std::size_t e = task / nw, w = task % nw;
       fill(windows_[w], edits[e], offset_[w], &out[e]);
@@ -261,7 +261,7 @@ std::vector<std::vector<Joints>> simulate_all(const Problem& pb,
                                               const sim::OmniModelEdit& e,
                                               int threads) {
   std::vector<std::vector<Joints>> out(pb.windows().size());
-  report::parallel_for(out.size(), threads, [&](std::size_t w) {
+  output::parallel_for(out.size(), threads, [&](std::size_t w) {
     if (!stop_requested()) out[w] = pb.simulate(w, e);
   });
   identify_stop_if_asked();
@@ -569,7 +569,7 @@ void write_calibrated_model(const sim::OmniModelEdit& fitted,
   const std::size_t eol = xml.find('\n');
   const std::string comment = "<!-- " + note + " -->\n";
   xml.insert(eol == std::string::npos ? xml.size() : eol + 1, comment);
-  report::write_file_atomically(path_out, xml);
+  output::write_file_atomically(path_out, xml);
 }
 
 }  // namespace vmh::bringup

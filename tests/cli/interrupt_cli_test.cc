@@ -3,7 +3,7 @@
 // exits 128 + the FIRST signal's number with one line naming it, and its
 // --out holds the previous whole set or a new whole set, never a part of
 // one, and no private folder is left beside it. The signal is sent once
-// the verb's private folder (report::OutputSet's ".<name>.tmp-<pid>-...")
+// the verb's private folder (output::OutputSet's ".<name>.tmp-<pid>-...")
 // appears, so that it lands in the work whatever the host's load; no
 // timing is asserted. Also compare --out's layout: one set, figures named
 // by recording, and the --out folders it refuses to replace.

@@ -115,7 +115,7 @@ std::string sti_error_line(const std::string& err) {
   return err.substr(at, end == std::string::npos ? std::string::npos : end - at);
 }
 
-// the private folders beside `dest` (report::OutputSet's ".<name>.tmp-...")
+// the private folders beside `dest` (output::OutputSet's ".<name>.tmp-...")
 std::vector<fs::path> sti_private_folders(const fs::path& dest) {
   std::vector<fs::path> found;
   const std::string prefix = "." + dest.filename().string() + ".";

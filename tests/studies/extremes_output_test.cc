@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "report/svg_chart.h"
+#include "output/svg_chart.h"
 #include "studies/extremes_study.h"
 #include "tests/support/svg_check.h"
 
@@ -64,10 +64,10 @@ TEST(ExtremesFigure, OnePanelPerScenarioWithItsWindowAndOutcome) {
     r.scenarios.push_back(s);
     r.energy.push_back(thin_energy(wavy_rows(1000), 100));
   }
-  const report::ChartGrid g = extremes_figure(r);
+  const output::ChartGrid g = extremes_figure(r);
   ASSERT_EQ(g.panels.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
-    const report::Chart& c = g.panels[i];
+    const output::Chart& c = g.panels[i];
     EXPECT_EQ(c.title, r.scenarios[i].scenario.name);
     EXPECT_EQ(c.subtitle, r.scenarios[i].outcome);
     EXPECT_DOUBLE_EQ(c.x.min, 0.0);
@@ -78,7 +78,7 @@ TEST(ExtremesFigure, OnePanelPerScenarioWithItsWindowAndOutcome) {
                      kExtremeDurationS + kExtremeRestS - kRestWindowS);
     // the observer in mJ, every thinned point
     const auto curve = std::find_if(c.series.begin(), c.series.end(),
-                                    [](const report::ChartSeries& s) {
+                                    [](const output::ChartSeries& s) {
                                       return s.x.size() > 2;
                                     });
     ASSERT_NE(curve, c.series.end());
@@ -86,13 +86,13 @@ TEST(ExtremesFigure, OnePanelPerScenarioWithItsWindowAndOutcome) {
     EXPECT_DOUBLE_EQ(*std::max_element(curve->y.begin(), curve->y.end()), 5.0);
     // the end of the script, a vertical line
     EXPECT_TRUE(std::any_of(c.series.begin(), c.series.end(),
-                            [](const report::ChartSeries& s) {
+                            [](const output::ChartSeries& s) {
                               return s.x.size() == 2 && s.x[0] == kExtremeDurationS &&
                                      s.x[1] == kExtremeDurationS;
                             }));
   }
   EXPECT_NE(g.panels[0].subtitle_color, g.panels[1].subtitle_color);
-  const std::string svg = report::chart_grid_svg(g);
+  const std::string svg = output::chart_grid_svg(g);
   EXPECT_EQ(vmh::testing::tag_problems(svg), "");
   EXPECT_EQ(vmh::testing::count(svg, "<svg class=\"chart\""), 2u);
 }

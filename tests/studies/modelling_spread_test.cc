@@ -39,8 +39,8 @@ TEST(ModellingSpread, ReadsTheCaseAndSaysWhichDominates) {
   EXPECT_DOUBLE_EQ(j.at("spread_over_default_error").get<double>(), 16.0 / 1.6e-5);
   EXPECT_EQ(modelling_spread_json(s, 32.0).at("dominant"), "numerical");
 
-  report::Chart chart;
-  report::ChartSeries data;
+  output::Chart chart;
+  output::ChartSeries data;
   data.x = {0.01, 0.5, 4.0};
   data.y = {1e-2, 1e-4, 1e-9};
   chart.series.push_back(data);

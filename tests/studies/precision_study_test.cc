@@ -214,7 +214,7 @@ TEST(PrecisionStudy, CaseOneAsComposed) {
   EXPECT_EQ(lines, static_cast<int>(r.rows.size()));
 
   // the chart: one line per integrator, then the default's marker
-  const vmh::report::Chart chart = vmh::studies::precision_chart(r);
+  const vmh::output::Chart chart = vmh::studies::precision_chart(r);
   ASSERT_GE(chart.series.size(), 4u);
   EXPECT_TRUE(chart.x.log);
   EXPECT_TRUE(chart.y.log);

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "report/svg_chart.h"
+#include "output/svg_chart.h"
 #include "tests/support/mujoco_guard.h"
 
 namespace vmh::studies {

@@ -1,4 +1,4 @@
-#include "report/progress.h"
+#include "output/progress.h"
 
 #include <unistd.h>
 
@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <iostream>
 
-namespace vmh::report {
+namespace vmh::output {
 namespace {
 
 // redraw at most this often, s: the terminal need not see every item
@@ -160,4 +160,4 @@ std::string Progress::format_line(const std::string& label, std::size_t done,
   return label + buf;
 }
 
-}  // namespace vmh::report
+}  // namespace vmh::output

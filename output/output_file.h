@@ -1,14 +1,14 @@
 // Writing the testbed's outputs (traces, summaries, tables, plots) so that a
 // failed or interrupted write never leaves a half-written file behind.
-#ifndef VMHAPTICS_REPORT_OUTPUT_FILE_H_
-#define VMHAPTICS_REPORT_OUTPUT_FILE_H_
+#ifndef VMHAPTICS_OUTPUT_OUTPUT_FILE_H_
+#define VMHAPTICS_OUTPUT_OUTPUT_FILE_H_
 
 #include <sys/types.h>
 
 #include <cstdint>
 #include <string>
 
-namespace vmh::report {
+namespace vmh::output {
 
 // What a path that is not a regular file is, for messages: "a folder",
 // "a FIFO", "a socket", "a character device", "a block device", "a
@@ -100,6 +100,6 @@ class OutputSet {
   bool committed_ = false;
 };
 
-}  // namespace vmh::report
+}  // namespace vmh::output
 
-#endif  // VMHAPTICS_REPORT_OUTPUT_FILE_H_
+#endif  // VMHAPTICS_OUTPUT_OUTPUT_FILE_H_

@@ -1,6 +1,6 @@
-// report/output_file.h: single files through a unique temporary name, and
+// output/output_file.h: single files through a unique temporary name, and
 // a folder's files as one set renamed into place whole (OutputSet).
-#include "report/output_file.h"
+#include "output/output_file.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-namespace vmh::report {
+namespace vmh::output {
 namespace {
 
 namespace fs = std::filesystem;
@@ -264,4 +264,4 @@ TEST(CheckWritableDir, NamesAReadOnlyFolder) {
 }
 
 }  // namespace
-}  // namespace vmh::report
+}  // namespace vmh::output

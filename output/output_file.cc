@@ -1,4 +1,4 @@
-#include "report/output_file.h"
+#include "output/output_file.h"
 
 #include <fcntl.h>
 #include <stdio.h>
@@ -16,7 +16,7 @@
 #include <system_error>
 #include <vector>
 
-namespace vmh::report {
+namespace vmh::output {
 namespace fs = std::filesystem;
 namespace {
 
@@ -310,4 +310,4 @@ void OutputSet::commit() {
   throw std::runtime_error(dest_ + ": " + os_error(err != 0 ? err : EBUSY));
 }
 
-}  // namespace vmh::report
+}  // namespace vmh::output

@@ -1,4 +1,4 @@
-#include "report/svg_chart.h"
+#include "output/svg_chart.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,9 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "report/svg_text.h"
+#include "output/svg_text.h"
 
-namespace vmh::report {
+namespace vmh::output {
 namespace {
 
 using svg::attr;
@@ -595,4 +595,4 @@ std::string chart_grid_svg(const ChartGrid& grid) {
   return svg + "</svg>\n";
 }
 
-}  // namespace vmh::report
+}  // namespace vmh::output

@@ -8,8 +8,8 @@
 // draws (tests). Worker threads call advance() or a part's callback: the
 // state is under a small mutex, taken once per finished work item, which is
 // far rarer than anything the items themselves do.
-#ifndef VMHAPTICS_REPORT_PROGRESS_H_
-#define VMHAPTICS_REPORT_PROGRESS_H_
+#ifndef VMHAPTICS_OUTPUT_PROGRESS_H_
+#define VMHAPTICS_OUTPUT_PROGRESS_H_
 
 #include <cstddef>
 #include <functional>
@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-namespace vmh::report {
+namespace vmh::output {
 
 // (done, total) of one job: what the studies report as items finish
 using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
@@ -82,6 +82,6 @@ class Progress {
 // whether file descriptor `fd` is a terminal: the default bar's one decision
 bool is_terminal(int fd);
 
-}  // namespace vmh::report
+}  // namespace vmh::output
 
-#endif  // VMHAPTICS_REPORT_PROGRESS_H_
+#endif  // VMHAPTICS_OUTPUT_PROGRESS_H_

@@ -1,4 +1,4 @@
-// report/svg_chart.cc: the chart is well-formed SVG, and its pixels say what
+// output/svg_chart.cc: the chart is well-formed SVG, and its pixels say what
 // the data says. Points are read back from the series' <polyline> and
 // <circle> elements and mapped against the plot area's frame
 // (<rect class="plot-area">): a point on an axis limit lands on the frame's
@@ -6,8 +6,8 @@
 // points are counted in <desc>.
 //
 // With VMH_SVG_CHART_DIR set, the charts are also written there for a look.
-#include "report/svg_chart.h"
-#include "report/svg_text.h"
+#include "output/svg_chart.h"
+#include "output/svg_text.h"
 
 #include <gtest/gtest.h>
 
@@ -27,7 +27,7 @@
 
 #include "tests/support/svg_check.h"
 
-namespace vmh::report {
+namespace vmh::output {
 namespace {
 
 using vmh::testing::count;
@@ -518,4 +518,4 @@ TEST(SvgText, PixelCoordinatesArePrintfsTwoDecimals) {
 }
 
 }  // namespace
-}  // namespace vmh::report
+}  // namespace vmh::output

@@ -1,14 +1,14 @@
 // Helpers shared by the SVG writers (plot_svg.cc, svg_chart.cc): numbers as
 // SVG wants them, XML escaping, and the step between an axis's ticks.
-#ifndef VMHAPTICS_REPORT_SVG_TEXT_H_
-#define VMHAPTICS_REPORT_SVG_TEXT_H_
+#ifndef VMHAPTICS_OUTPUT_SVG_TEXT_H_
+#define VMHAPTICS_OUTPUT_SVG_TEXT_H_
 
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <string>
 
-namespace vmh::report::svg {
+namespace vmh::output::svg {
 
 // one number through printf's format f
 inline std::string format(const char* f, double v) {
@@ -64,6 +64,6 @@ inline double nice_step(double span, double ticks) {
   return 10.0 * mag;
 }
 
-}  // namespace vmh::report::svg
+}  // namespace vmh::output::svg
 
-#endif  // VMHAPTICS_REPORT_SVG_TEXT_H_
+#endif  // VMHAPTICS_OUTPUT_SVG_TEXT_H_

@@ -2,8 +2,8 @@
 // run builds its own model and data; each loop's hand is registered for its
 // own mjData (sim/hand.h) and model loading is serialised (mujoco_util.h),
 // so runs on different threads do not disturb each other.
-#ifndef VMHAPTICS_REPORT_PARALLEL_H_
-#define VMHAPTICS_REPORT_PARALLEL_H_
+#ifndef VMHAPTICS_OUTPUT_PARALLEL_H_
+#define VMHAPTICS_OUTPUT_PARALLEL_H_
 
 #include <algorithm>
 #include <atomic>
@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-namespace vmh::report {
+namespace vmh::output {
 
 // the number of hardware threads, at least 1
 inline int core_count() {
@@ -35,6 +35,6 @@ void parallel_for(std::size_t n, int threads, Body body) {
   for (std::thread& t : pool) t.join();
 }
 
-}  // namespace vmh::report
+}  // namespace vmh::output
 
-#endif  // VMHAPTICS_REPORT_PARALLEL_H_
+#endif  // VMHAPTICS_OUTPUT_PARALLEL_H_

@@ -15,14 +15,14 @@
 // Several charts can share one document as panels of a grid (ChartGrid):
 // each panel is a nested <svg class="chart" id="panel-K"> whose element ids
 // start with "panel-K-" (so "panel-K-series-N").
-#ifndef VMHAPTICS_REPORT_SVG_CHART_H_
-#define VMHAPTICS_REPORT_SVG_CHART_H_
+#ifndef VMHAPTICS_OUTPUT_SVG_CHART_H_
+#define VMHAPTICS_OUTPUT_SVG_CHART_H_
 
 #include <cmath>
 #include <string>
 #include <vector>
 
-namespace vmh::report {
+namespace vmh::output {
 
 struct ChartSeries {
   std::string label;        // legend text
@@ -95,6 +95,6 @@ struct ChartGrid {
 // std::invalid_argument as chart_svg does, naming the panel.
 std::string chart_grid_svg(const ChartGrid& grid);
 
-}  // namespace vmh::report
+}  // namespace vmh::output
 
-#endif  // VMHAPTICS_REPORT_SVG_CHART_H_
+#endif  // VMHAPTICS_OUTPUT_SVG_CHART_H_

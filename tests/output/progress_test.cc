@@ -1,7 +1,7 @@
 // The progress bar: what it draws against a fake clock, that concurrent
 // advances all count, and that it keeps quiet on a stderr that is no
 // terminal.
-#include "report/progress.h"
+#include "output/progress.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-namespace vmh::report {
+namespace vmh::output {
 namespace {
 
 // the percentages drawn, in order
@@ -120,4 +120,4 @@ TEST(ProgressTest, FormatLineNamesWhatIsLeft) {
 }
 
 }  // namespace
-}  // namespace vmh::report
+}  // namespace vmh::output
