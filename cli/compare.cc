@@ -43,12 +43,12 @@
 #include "runtime/stop.h"
 #include "output/output_file.h"
 #include "sim/mujoco_util.h"
-#include "studies/bringup/compare_check.h"
-#include "studies/bringup/compare_force.h"
-#include "studies/bringup/compare_jacobian.h"
-#include "studies/bringup/compare_kinematics.h"
-#include "studies/bringup/compare_replay.h"
-#include "studies/bringup/recording.h"
+#include "bringup/compare_check.h"
+#include "bringup/compare_force.h"
+#include "bringup/compare_jacobian.h"
+#include "bringup/compare_kinematics.h"
+#include "bringup/compare_replay.h"
+#include "bringup/recording.h"
 
 namespace vmh::cli {
 namespace {

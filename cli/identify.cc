@@ -2,7 +2,7 @@
 //                    [--fit mass,friction,damping,gains] [--serial S]
 //
 // Fits the MJCF Omni's uncertain scales to recordings' motor pulses
-// (studies/bringup/identify.h says how, and what cannot be identified),
+// (bringup/identify.h says how, and what cannot be identified),
 // writes the calibrated model (default
 // <models>/omni/calibrated/<serial>.xml) and, with --out, DIR/identify.json
 // and DIR/identify_fit.svg. Prints one JSON object.
@@ -32,8 +32,8 @@
 #include "runtime/json_util.h"
 #include "output/output_file.h"
 #include "output/svg_chart.h"
-#include "studies/bringup/identify.h"
-#include "studies/bringup/recording.h"
+#include "bringup/identify.h"
+#include "bringup/recording.h"
 #include "studies/run_case.h"
 
 namespace vmh::cli {

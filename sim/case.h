@@ -74,7 +74,7 @@ class Case {
   // The same case with the controller's four gains (K_p, K_ornt, K_v and
   // K_v,ornt, in the parameters and the controller alike) times `scale`:
   // a session run at scaled gains, as `hw run --gain-scale` runs one and
-  // the replay of its recording must (studies/bringup/compare_replay.cc).
+  // the replay of its recording must (bringup/compare_replay.cc).
   // Throws SimError naming the scene when `scale` is not finite and > 0.
   Case with_gains_scaled(double scale) const;
 

@@ -3,7 +3,7 @@
 // recordings (the workspace tour, a pulse on each motor) are made in real
 // time and compare must name that fault and nothing else; a clean set must
 // pass every check. The answer is in meta.json only under the emulator's
-// hidden key, which compare does not read (studies/bringup/).
+// hidden key, which compare does not read (bringup/).
 #include <gtest/gtest.h>
 
 #include <filesystem>

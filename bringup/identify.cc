@@ -1,0 +1,575 @@
+#include "bringup/identify.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "controller/device_frame.h"
+#include "controller/omni_kinematics.h"
+#include "device/stop_signal.h"
+#include "output/output_file.h"
+#include "output/parallel.h"
+#include "runtime/stop.h"
+#include "sim/mujoco_util.h"
+#include "sim/sensor_model.h"
+#include "bringup/response_sim.h"
+
+namespace vmh::bringup {
+namespace {
+
+constexpr double kLogStep = 0.01;      // finite-difference step, log scale
+constexpr double kLogBound = 3.0;      // scales kept within e^+-3 (x0.05..x20)
+constexpr double kBadResidual = 1e6;   // a simulation that blew up
+// half a quantization step in weighted units (a step is sqrt(12))
+const double kHalfStep = std::sqrt(3.0);
+
+// a SIGINT or SIGTERM during the fit (device/stop_signal.h): the
+// simulations still queued are skipped and the fit ends here, before the
+// verb writes anything
+void identify_stop_if_asked() {
+  runtime::throw_if_stopped("identify", "; nothing written");
+}
+
+// One pushed stretch of one recording, ready to simulate
+struct Window {
+  std::size_t recording = 0;
+  int motor = 1;  // the motor that pushed hardest
+  ResponseSimulator* sim = nullptr;
+  ResponseInput input;
+  std::vector<Joints> measured;  // device angles, rad
+};
+
+// Which scale a fitted parameter sets
+struct Param {
+  std::string name;
+  int gain_motor = -1;  // 0..2 for a gain, else -1
+};
+
+std::vector<Param> parse_fit(const std::vector<std::string>& fit) {
+  std::vector<Param> out;
+  for (const std::string& f : fit) {
+    if (f == "mass") {
+      out.push_back({"mass_scale"});
+    } else if (f == "friction") {
+      out.push_back({"friction_scale"});
+    } else if (f == "damping") {
+      out.push_back({"damping_scale"});
+    } else if (f == "gains") {
+      for (int i = 0; i < 3; ++i) {
+        out.push_back({"motor_gain" + std::to_string(i + 1) + "_scale", i});
+      }
+    } else {
+      throw IdentifyError("identify: unknown parameter '" + f +
+                          "' to fit (expected mass, friction, damping, gains)");
+    }
+  }
+  if (out.empty()) throw IdentifyError("identify: nothing to fit");
+  return out;
+}
+
+// The edit at log-scales x over `base` (which holds the signs)
+sim::OmniModelEdit edit_at(const std::vector<Param>& params,
+                           const Eigen::VectorXd& x,
+                           const sim::OmniModelEdit& base) {
+  sim::OmniModelEdit e = base;
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const double s = std::exp(x[static_cast<Eigen::Index>(i)]);
+    const Param& p = params[i];
+    if (p.gain_motor >= 0) {
+      e.motor_gain[p.gain_motor] *= s;
+    } else if (p.name == "mass_scale") {
+      e.mass_scale *= s;
+    } else if (p.name == "friction_scale") {
+      e.friction_scale *= s;
+    } else {
+      e.damping_scale *= s;
+    }
+  }
+  return e;
+}
+
+// a parameter's value in an edit (a gain's magnitude)
+double scale_of(const Param& p, const sim::OmniModelEdit& e) {
+  if (p.gain_motor >= 0) return std::abs(e.motor_gain[p.gain_motor]);
+  if (p.name == "mass_scale") return e.mass_scale;
+  if (p.name == "friction_scale") return e.friction_scale;
+  return e.damping_scale;
+}
+
+std::string scene_of(const Recording& r, const IdentifyOptions& o) {
+  std::string scene = r.emulator_scene();
+  if (!scene.empty()) return scene;
+  if (o.default_scene.empty()) {
+    throw IdentifyError("identify: recording " + r.dir +
+                        " names no scene (meta.json emulator.scene) and no "
+                        "default scene was given");
+  }
+  return o.default_scene;
+}
+
+// The recording's pushed windows: runs of rows with a nonzero torque sent,
+// merged when closer than a window's margins, widened by them
+void find_windows(const Recording& r, std::size_t index,
+                  const IdentifyOptions& o, ResponseSimulator* sim,
+                  std::vector<Window>* out) {
+  const std::vector<std::size_t> good = r.good_rows();
+  std::vector<Vec3> tau(r.rows);
+  for (std::size_t k = 0; k < r.rows; ++k) {
+    tau[k] = r.tau_sent_Nm(k);
+    if (!tau[k].allFinite()) tau[k] = Vec3::Zero();
+  }
+  std::vector<std::pair<double, double>> pulses;  // [start, end] s
+  for (std::size_t k = 0; k < r.rows; ++k) {
+    if (tau[k].cwiseAbs().maxCoeff() <= 0.0) continue;
+    const double t = r.t_s(k);
+    if (!pulses.empty() && t - pulses.back().second <= o.before_s + o.after_s) {
+      pulses.back().second = t;
+    } else {
+      pulses.emplace_back(t, t);
+    }
+  }
+  for (const auto& [t_on, t_off] : pulses) {
+    Window w;
+    w.recording = index;
+    w.sim = sim;
+    Vec3 peak = Vec3::Zero();
+    for (std::size_t k : good) {
+      const double t = r.t_s(k);
+      if (t < t_on - o.before_s || t > t_off + o.after_s) continue;
+      w.input.t_s.push_back(t);
+      w.input.tau_motor_Nm.push_back(tau[k]);
+      w.measured.push_back(dh_to_device_joints(r.q_dh_rad(k)));
+      peak = peak.cwiseMax(tau[k].cwiseAbs());
+    }
+    if (w.input.t_s.size() < 10) continue;  // too few readings to judge
+    peak.maxCoeff(&w.motor);
+    w.motor += 1;
+    w.input.q0_device_rad = w.measured.front();
+    // at rest before a pulse; a least-squares slope over 10 ms otherwise
+    w.input.qdot0_device_rad_s =
+        velocity_estimate(w.input.t_s, w.measured, 0, 0.01);
+    out->push_back(std::move(w));
+  }
+}
+
+// Everything the fit evaluates: weighted residuals of every window
+class Problem {
+ public:
+  Problem(std::vector<Window> windows, int threads)
+      : windows_(std::move(windows)), threads_(threads) {
+    const sim::SensorModel sensors(OmniParams(), true);
+    for (int j = 0; j < 6; ++j) {
+      weight_[j] = std::sqrt(12.0) / sensors.resolution_rad()[static_cast<std::size_t>(j)];
+    }
+    for (const Window& w : windows_) {
+      offset_.push_back(size_);
+      size_ += 6 * (w.measured.size() - 1);
+    }
+  }
+
+  std::size_t size() const { return size_; }
+  Joints weighted(const Joints& dq) const {
+    return dq.cwiseProduct(Eigen::Map<const Joints>(weight_));
+  }
+
+  // correlation of each residual with the next sample's of the same joint
+  double lag1_correlation(const Eigen::VectorXd& r) const {
+    double num = 0.0, den = 0.0;
+    for (std::size_t w = 0; w < windows_.size(); ++w) {
+      const std::size_t n = windows_[w].measured.size() - 1;
+      for (std::size_t k = 0; k < n; ++k) {
+        for (std::size_t j = 0; j < 6; ++j) {
+          const double a = r[static_cast<Eigen::Index>(offset_[w] + 6 * k + j)];
+          den += a * a;
+          if (k + 1 < n) num += a * r[static_cast<Eigen::Index>(offset_[w] + 6 * (k + 1) + j)];
+        }
+      }
+    }
+    return den > 0.0 ? num / den : 0.0;
+  }
+  const std::vector<Window>& windows() const { return windows_; }
+
+  // residuals of each (edit, window) pair, in parallel; out[i] gets
+  // edits[i]'s whole residual vector
+  std::vector<Eigen::VectorXd> residuals(
+      const std::vector<sim::OmniModelEdit>& edits) const {
+    std::vector<Eigen::VectorXd> out(edits.size(), Eigen::VectorXd::Zero(
+                                                       static_cast<Eigen::Index>(size_)));
+    const std::size_t nw = windows_.size();
+    output::parallel_for(edits.size() * nw, threads_, [&](std::size_t task) {
+      if (stop_requested()) return;  // thrown below, on this thread
+      const std::size_t e = task / nw, w = task % nw;
+      fill(windows_[w], edits[e], offset_[w], &out[e]);
+    });
+    identify_stop_if_asked();
+    return out;
+  }
+
+  // one window simulated under `edit` (device angles), empty when it fails
+  std::vector<Joints> simulate(std::size_t w, const sim::OmniModelEdit& edit) const {
+    try {
+      const SimulatedResponse r = windows_[w].sim->simulate(windows_[w].input, edit);
+      if (r.finite) return r.q_device_rad;
+    } catch (const std::exception&) {
+    }
+    return {};
+  }
+
+ private:
+  void fill(const Window& w, const sim::OmniModelEdit& edit, std::size_t at,
+            Eigen::VectorXd* r) const {
+    std::vector<Joints> q;
+    try {
+      const SimulatedResponse s = w.sim->simulate(w.input, edit);
+      if (s.finite) q = s.q_device_rad;
+    } catch (const std::exception&) {
+      // an edit MuJoCo rejects counts as a very bad fit
+    }
+    const std::size_t n = w.measured.size() - 1;
+    for (int j = 0; j < 6; ++j) {
+      // the start is known only to within a sensor step, and the whole
+      // simulated run carries that offset: take it out, as the constant
+      // of at most half a step that fits best (else the fit bends the
+      // physics to move the joints that barely move by that much)
+      double mean = 0.0;
+      for (std::size_t k = 1; k <= n && !q.empty(); ++k) {
+        mean += weight_[j] * (q[k][j] - w.measured[k][j]) / static_cast<double>(n);
+      }
+      const double offset = std::clamp(mean, -kHalfStep, kHalfStep);
+      for (std::size_t k = 1; k <= n; ++k) {
+        const auto i = static_cast<Eigen::Index>(at + 6 * (k - 1) + static_cast<std::size_t>(j));
+        (*r)[i] = q.empty() ? kBadResidual
+                            : weight_[j] * (q[k][j] - w.measured[k][j]) - offset;
+      }
+    }
+  }
+
+  std::vector<Window> windows_;
+  int threads_;
+  double weight_[6];
+  std::vector<std::size_t> offset_;
+  std::size_t size_ = 0;
+};
+
+std::vector<std::vector<Joints>> simulate_all(const Problem& pb,
+                                              const sim::OmniModelEdit& e,
+                                              int threads) {
+  std::vector<std::vector<Joints>> out(pb.windows().size());
+  output::parallel_for(out.size(), threads, [&](std::size_t w) {
+    if (!stop_requested()) out[w] = pb.simulate(w, e);
+  });
+  identify_stop_if_asked();
+  return out;
+}
+
+// Each pushed motor's sign at the starting model: the one whose simulated
+// displacement points the way the measured one does. The cosine between
+// them (weighted joints, every sample) is scale-free, so a model far off
+// in mass or friction still tells the direction where comparing the two
+// signs' costs would not (both miss by about the same when the model
+// moves much more than the arm did).
+std::vector<MotorSign> choose_signs(const Problem& pb, int threads,
+                                    sim::OmniModelEdit* base) {
+  const std::vector<std::vector<Joints>> q = simulate_all(pb, *base, threads);
+  std::vector<MotorSign> out;
+  for (int m = 1; m <= 3; ++m) {
+    double dot = 0.0, sim2 = 0.0, meas2 = 0.0;
+    bool pushed = false;
+    for (std::size_t w = 0; w < pb.windows().size(); ++w) {
+      const Window& win = pb.windows()[w];
+      if (win.motor != m || q[w].empty()) continue;
+      pushed = true;
+      for (std::size_t k = 1; k < win.measured.size(); ++k) {
+        const Joints ds = pb.weighted(q[w][k] - q[w][0]);
+        const Joints dm = pb.weighted(win.measured[k] - win.measured[0]);
+        dot += ds.dot(dm);
+        sim2 += ds.squaredNorm();
+        meas2 += dm.squaredNorm();
+      }
+    }
+    if (!pushed) continue;
+    MotorSign ms;
+    ms.motor = m;
+    ms.agreement = sim2 > 0.0 && meas2 > 0.0 ? dot / std::sqrt(sim2 * meas2) : 0.0;
+    ms.sign = ms.agreement < 0.0 ? -1 : 1;
+    ms.determined = std::abs(ms.agreement) >= 0.5;
+    if (ms.sign < 0) base->motor_gain[m - 1] = -base->motor_gain[m - 1];
+    out.push_back(ms);
+  }
+  return out;
+}
+
+// the wrist centre of device angles q, device frame, mm
+Vec3 wrist_mm(const Joints& q_device) {
+  const OmniParams omni;
+  return base_to_device_mm(omni, omni_fk(omni, device_to_dh_joints(q_device)).p_base_m);
+}
+
+// RMS over the windows of one recording (rad over t1..t6, mm at the wrist)
+void recording_rms(const Problem& pb, std::size_t rec,
+                   const std::vector<std::vector<Joints>>& sim, double* rad,
+                   double* mm) {
+  double s_rad = 0.0, s_mm = 0.0;
+  std::size_t n = 0;
+  for (std::size_t w = 0; w < pb.windows().size(); ++w) {
+    const Window& win = pb.windows()[w];
+    if (win.recording != rec) continue;
+    for (std::size_t k = 1; k < win.measured.size(); ++k) {
+      if (sim[w].empty()) return void(*rad = *mm = std::nan(""));
+      s_rad += (sim[w][k] - win.measured[k]).squaredNorm() / 6.0;
+      s_mm += (wrist_mm(sim[w][k]) - wrist_mm(win.measured[k])).squaredNorm();
+      ++n;
+    }
+  }
+  *rad = n ? std::sqrt(s_rad / static_cast<double>(n)) : 0.0;
+  *mm = n ? std::sqrt(s_mm / static_cast<double>(n)) : 0.0;
+}
+
+}  // namespace
+
+IdentifyResult identify(const std::vector<Recording>& recordings,
+                        const IdentifyOptions& o) {
+  const std::vector<Param> params = parse_fit(o.fit);
+  IdentifyResult res;
+  // one simulator per scene: loading checks it once
+  std::map<std::string, std::unique_ptr<ResponseSimulator>> sims;
+  std::vector<Window> windows;
+  std::vector<std::size_t> used;  // index into recordings, per res.recordings
+  for (std::size_t i = 0; i < recordings.size(); ++i) {
+    const Recording& r = recordings[i];
+    if (!r.has("tau_sent_1_Nm")) {
+      res.notes.push_back(r.dir + ": ignored, no tau_sent columns");
+      continue;
+    }
+    const std::size_t before = windows.size();
+    const std::string scene = scene_of(r, o);
+    auto& sim = sims[scene];
+    if (!sim) sim = std::make_unique<ResponseSimulator>(scene);
+    find_windows(r, res.recordings.size(), o, sim.get(), &windows);
+    if (windows.size() == before) {
+      res.notes.push_back(r.dir + ": ignored, no torque sent (or too few readings around it)");
+      continue;
+    }
+    if (r.verb != "hw motor-test") {
+      res.notes.push_back(r.dir + ": a '" + r.verb +
+                          "' recording, simulated with nobody holding the stylus");
+    }
+    RecordingFit f;
+    f.dir = r.dir;
+    f.windows = static_cast<int>(windows.size() - before);
+    for (std::size_t w = before; w < windows.size(); ++w) {
+      f.samples += windows[w].measured.size();
+    }
+    res.recordings.push_back(f);
+    used.push_back(i);
+  }
+  if (windows.empty()) {
+    std::string names;
+    for (const Recording& r : recordings) names += (names.empty() ? "" : ", ") + r.dir;
+    throw IdentifyError("identify: no usable motor pulse in " +
+                        (names.empty() ? std::string("(no recordings)") : names));
+  }
+  const int threads = std::max(1, o.threads);
+  const Problem pb(std::move(windows), threads);
+  const auto P = static_cast<Eigen::Index>(params.size());
+  const auto N = static_cast<Eigen::Index>(pb.size());
+  if (N <= P) throw IdentifyError("identify: fewer readings than parameters");
+
+  sim::OmniModelEdit base = o.initial;
+  if (o.find_signs) res.signs = choose_signs(pb, threads, &base);
+
+  // Levenberg-Marquardt on log-scales, Marquardt's diagonal scaling
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(P);
+  Eigen::VectorXd r = pb.residuals({edit_at(params, x, base)})[0];
+  double cost = r.squaredNorm();
+  res.cost_before = cost / static_cast<double>(N);
+  Eigen::MatrixXd J(N, P);
+  double lambda = 1e-3;
+  auto jacobian = [&]() {
+    std::vector<sim::OmniModelEdit> edits;
+    for (Eigen::Index p = 0; p < P; ++p) {
+      for (double s : {+1.0, -1.0}) {
+        Eigen::VectorXd xp = x;
+        xp[p] += s * kLogStep;
+        edits.push_back(edit_at(params, xp, base));
+      }
+    }
+    const std::vector<Eigen::VectorXd> rs = pb.residuals(edits);
+    for (Eigen::Index p = 0; p < P; ++p) {
+      J.col(p) = (rs[static_cast<std::size_t>(2 * p)] - rs[static_cast<std::size_t>(2 * p + 1)]) /
+                 (2.0 * kLogStep);
+    }
+  };
+  jacobian();
+  for (res.iterations = 0; res.iterations < o.max_iterations;) {
+    ++res.iterations;
+    const Eigen::MatrixXd A = J.transpose() * J;
+    const Eigen::VectorXd g = J.transpose() * r;
+    bool stepped = false;
+    for (int tries = 0; tries < 8 && !stepped; ++tries) {
+      Eigen::MatrixXd Ad = A;
+      Ad.diagonal() += lambda * A.diagonal().cwiseMax(1e-12);
+      Eigen::VectorXd dx = Ad.ldlt().solve(-g);
+      const Eigen::VectorXd xn = (x + dx).cwiseMax(-kLogBound).cwiseMin(kLogBound);
+      dx = xn - x;
+      const Eigen::VectorXd rn = pb.residuals({edit_at(params, xn, base)})[0];
+      const double cn = rn.squaredNorm();
+      if (cn < cost) {
+        const double gain = (cost - cn) / cost;
+        x = xn;
+        r = rn;
+        cost = cn;
+        lambda = std::max(lambda / 3.0, 1e-7);
+        stepped = true;
+        // done when the step is small against the parameters' own
+        // uncertainty (or the cost no longer moves): further digits mean
+        // nothing
+        const double rho = std::clamp(pb.lag1_correlation(r), 0.0, 0.99);
+        const Eigen::VectorXd sd_log =
+            (cost / static_cast<double>(N - P) * (1.0 + rho) / (1.0 - rho) *
+             A.completeOrthogonalDecomposition().pseudoInverse().diagonal())
+                .cwiseMax(0.0)
+                .cwiseSqrt();
+        if ((dx.cwiseAbs().array() <= 0.1 * sd_log.array() + 1e-6).all() || gain < 1e-9) {
+          res.converged = true;
+        }
+      } else {
+        lambda *= 4.0;
+      }
+    }
+    if (!stepped) {
+      // no direction lowers the cost: a minimum within the step's reach
+      res.converged = true;
+    }
+    if (res.converged) break;
+    jacobian();
+  }
+  res.cost_after = cost / static_cast<double>(N);
+  res.residuals = pb.size();
+  res.edit = edit_at(params, x, base);
+  jacobian();  // at the solution, for the covariance
+
+  // covariance of the log-scales, s^2 (J^T J)^-1, widened for residuals
+  // that are not independent: quantization error and model error run in
+  // staircases, so neighbouring samples repeat each other. An AR(1)
+  // reading of the residuals' lag-one correlation rho gives the factor
+  // (1 + rho) / (1 - rho) on the variance.
+  res.residual_lag1_correlation = pb.lag1_correlation(r);
+  const double rho = std::clamp(res.residual_lag1_correlation, 0.0, 0.99);
+  res.sigma_inflation = std::sqrt((1.0 + rho) / (1.0 - rho));
+  const double s2 = cost / static_cast<double>(N - P) * (1.0 + rho) / (1.0 - rho);
+  const Eigen::MatrixXd cov =
+      s2 * (J.transpose() * J).completeOrthogonalDecomposition().pseudoInverse();
+  const Eigen::VectorXd sd = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
+  res.correlation = Eigen::MatrixXd::Identity(P, P);
+  for (Eigen::Index i = 0; i < P; ++i) {
+    for (Eigen::Index j = 0; j < P; ++j) {
+      if (i != j && sd[i] > 0.0 && sd[j] > 0.0) {
+        res.correlation(i, j) = cov(i, j) / (sd[i] * sd[j]);
+      }
+    }
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(res.correlation);
+  const double lo = eig.eigenvalues().minCoeff(), hi = eig.eigenvalues().maxCoeff();
+  res.condition_number = lo > 0.0 ? hi / lo : std::numeric_limits<double>::infinity();
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < P; ++i) {
+    for (Eigen::Index j = i + 1; j < P; ++j) {
+      if (std::abs(res.correlation(i, j)) > std::abs(worst)) {
+        worst = res.correlation(i, j);
+        res.conditioning = params[static_cast<std::size_t>(i)].name + " and " +
+                           params[static_cast<std::size_t>(j)].name;
+      }
+    }
+  }
+  res.poorly_conditioned = std::abs(worst) > o.max_correlation;
+  // free motion without gravity: scaling masses, damping, friction and
+  // gains together changes nothing but the parts mass_scale leaves alone
+  // (the motors' armature, the hand's mass on the grip), so the fit
+  // separates mass from gain only by trusting those assumed values
+  bool mass = false, gains = false;
+  for (const Param& p : params) {
+    mass = mass || p.name == "mass_scale";
+    gains = gains || p.gain_motor >= 0;
+  }
+  const bool degenerate = mass && gains;
+  res.poorly_conditioned = res.poorly_conditioned || degenerate;
+  {
+    std::ostringstream s;
+    s << (res.conditioning.empty() ? "one parameter" : res.conditioning +
+                                     " correlated " + std::to_string(worst))
+      << "; condition number " << res.condition_number
+      << (degenerate ? ": poorly conditioned by the physics: mass and motor gains are "
+                       "separated only through the assumed motor armature and hand mass "
+                       "(free motion, no gravity, no force reference)"
+          : res.poorly_conditioned ? ": poorly conditioned (not separable from these recordings)"
+                                   : ": well conditioned");
+    res.conditioning = s.str();
+  }
+  for (Eigen::Index i = 0; i < P; ++i) {
+    FittedParameter fp;
+    fp.name = params[static_cast<std::size_t>(i)].name;
+    fp.fitted = scale_of(params[static_cast<std::size_t>(i)], res.edit);
+    fp.sigma = fp.fitted * sd[i];  // delta method from the log
+    fp.identified = fp.sigma <= o.max_relative_sigma * fp.fitted;
+    res.parameters.push_back(fp);
+  }
+
+  // residuals and traces before (nominal, signs as written) and after
+  const std::vector<std::vector<Joints>> q0 = simulate_all(pb, {}, threads);
+  const std::vector<std::vector<Joints>> q1 = simulate_all(pb, res.edit, threads);
+  for (std::size_t i = 0; i < res.recordings.size(); ++i) {
+    RecordingFit& f = res.recordings[i];
+    recording_rms(pb, i, q0, &f.rms_before_rad, &f.rms_before_mm);
+    recording_rms(pb, i, q1, &f.rms_after_rad, &f.rms_after_mm);
+  }
+  for (std::size_t w = 0; w < pb.windows().size(); ++w) {
+    const Window& win = pb.windows()[w];
+    WindowTrace t;
+    t.recording = win.recording;
+    t.motor = win.motor;
+    t.t_s = win.input.t_s;
+    const int j = win.motor - 1;
+    for (std::size_t k = 0; k < win.measured.size(); ++k) {
+      t.measured_rad.push_back(win.measured[k][j]);
+      t.before_rad.push_back(q0[w].empty() ? std::nan("") : q0[w][k][j]);
+      t.after_rad.push_back(q1[w].empty() ? std::nan("") : q1[w][k][j]);
+    }
+    res.traces.push_back(std::move(t));
+  }
+  return res;
+}
+
+void write_calibrated_model(const sim::OmniModelEdit& fitted,
+                            const std::string& omni_xml_in,
+                            const std::string& path_out,
+                            const std::string& provenance) {
+  // MuJoCo writes the file itself; the comment goes in after, and the
+  // whole replaces path_out at once
+  const std::string tmp = path_out + ".mujoco.xml";
+  sim::save_edited_model_xml(
+      omni_xml_in, [&](mjModel* m) { sim::apply_omni_edit(m, fitted); }, tmp);
+  std::ifstream in(tmp);
+  std::stringstream text;
+  text << in.rdbuf();
+  in.close();
+  std::remove(tmp.c_str());
+  std::string xml = text.str();
+  // "--" may not appear inside an XML comment
+  std::string note = provenance;
+  for (std::size_t p = note.find("--"); p != std::string::npos; p = note.find("--", p)) {
+    note.replace(p, 2, "- -");
+  }
+  const std::size_t eol = xml.find('\n');
+  const std::string comment = "<!-- " + note + " -->\n";
+  xml.insert(eol == std::string::npos ? xml.size() : eol + 1, comment);
+  output::write_file_atomically(path_out, xml);
+}
+
+}  // namespace vmh::bringup
