@@ -19,6 +19,7 @@
 #include "sim/closed_loop.h"
 #include "sim/emulator_hand.h"
 #include "tests/support/constants.h"
+#include "tests/support/read_file.h"
 
 namespace vmh::bringup {
 namespace {
@@ -288,8 +289,7 @@ TEST(CompareForce, WritesTheFigure) {
   ASSERT_EQ(s.figures.size(), 1u);
   EXPECT_EQ(std::filesystem::path(s.figures[0]).filename(),
             "force_direction_motor2.svg");
-  std::ifstream f(s.figures[0]);
-  const std::string text((std::istreambuf_iterator<char>(f)), {});
+  const std::string text = vmh::testing::read_file(s.figures[0]);
   EXPECT_NE(text.find("class=\"chart-grid\""), std::string::npos);
   EXPECT_TRUE(s.detail["history"].is_array());
   EXPECT_GT(s.detail["history"].size(), 10u);

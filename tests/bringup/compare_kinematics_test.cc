@@ -20,6 +20,7 @@
 #include "tests/bringup/synthetic_recording.h"
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/openhaptics_reference.h"
+#include "tests/support/read_file.h"
 
 namespace vmh::bringup {
 namespace {
@@ -272,11 +273,9 @@ TEST_F(CompareKinematics, FiguresAreWritten) {
   ASSERT_EQ(k.figures.size(), 1u);
   ASSERT_EQ(j.figures.size(), 1u);
   for (const std::string& f : {k.figures[0], j.figures[0]}) {
-    std::ifstream in(f);
-    std::stringstream text;
-    text << in.rdbuf();
-    EXPECT_NE(text.str().find("<svg"), std::string::npos) << f;
-    EXPECT_NE(text.str().find("series-1"), std::string::npos) << f;
+    const std::string text = vmh::testing::read_file(f);
+    EXPECT_NE(text.find("<svg"), std::string::npos) << f;
+    EXPECT_NE(text.find("series-1"), std::string::npos) << f;
   }
 }
 

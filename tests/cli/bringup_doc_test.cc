@@ -72,10 +72,8 @@ TEST(BringupDoc, RunsEndToEndOnTheEmulator) {
                           ":$PATH DEVICE=emulator XDG_CONFIG_HOME=" +
                           (dir / "config").string() + " bash bringup.sh > log.txt 2>&1";
   const int status = std::system(cmd.c_str());
-  std::ifstream log(dir / "log.txt");
-  std::stringstream ss;
-  ss << log.rdbuf();
-  ASSERT_EQ(status, 0) << "the procedure failed; its output:\n" << ss.str();
+  ASSERT_EQ(status, 0) << "the procedure failed; its output:\n"
+                       << vmh::testing::read_file(dir / "log.txt");
 
   // what each step left behind says what the page says it shows
   const fs::path b = dir / "bringup";

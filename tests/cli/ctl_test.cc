@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -535,11 +536,9 @@ TEST(Params, DocsFileIsWhatTheProgramPrints) {
   const CliRun r = run("params");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
-  std::ifstream in(std::string(VMH_MODELS_DIR) + "/../docs/parameters.md");
-  ASSERT_TRUE(in.good());
-  std::stringstream text;
-  text << in.rdbuf();
-  EXPECT_EQ(r.out, text.str())
+  const std::string doc = std::string(VMH_MODELS_DIR) + "/../docs/parameters.md";
+  ASSERT_TRUE(std::filesystem::is_regular_file(doc)) << doc;
+  EXPECT_EQ(r.out, vmh::testing::read_file(doc))
       << "regenerate: build/vmhaptics params > docs/parameters.md";
   for (const char* row : {"| `k_vel_ornt_Nmms_per_rad` | `--kv-ornt` |",
                           "| `friction_mu` | `--mu` |",

@@ -28,12 +28,6 @@ fs::path fresh_dir(const std::string& name) {
   return vmh::testing::fresh_dir("vmh_emufault_", name);
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 int lines(const std::string& s) {
   int n = 0;
@@ -47,7 +41,7 @@ TEST(HwEmulatorFault, RecordKeepsTheFaultsHiddenInMeta) {
                          " --emulator-fault joint1_sign,gimbal_swap --model " + kOmni,
                      kEnv);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const json meta = json::parse(slurp(out / "meta.json"));
+  const json meta = json::parse(vmh::testing::read_file(out / "meta.json"));
   const json& emu = meta.at("emulator");
   EXPECT_EQ(emu.at("seeded_faults"), json({"joint1_sign", "gimbal_swap"}));
   EXPECT_EQ(emu.at("hand"), "tour");
@@ -58,7 +52,7 @@ TEST(HwEmulatorFault, RecordKeepsTheFaultsHiddenInMeta) {
   EXPECT_EQ(scene.filename(), "case1.xml");
   // the device's own kinematics are in the trace; the faults are not in
   // the trace or on stdout
-  const std::string trace = slurp(out / "trace.csv");
+  const std::string trace = vmh::testing::read_file(out / "trace.csv");
   const std::string header = trace.substr(0, trace.find('\n'));
   for (const char* c : {"dev_p_x_mm", "dev_R_33", "dev_v_z_mm_s", "dev_J_11", "dev_J_66"}) {
     EXPECT_NE(header.find(c), std::string::npos) << c;
@@ -74,7 +68,7 @@ TEST(HwEmulatorFault, WithoutFaultsMetaHasTheSetupAndAnEmptyList) {
   const fs::path out = fresh_dir("plain");
   const auto r = run("hw record --duration 0.5 --quiet --out " + out.string(), kEnv);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const json emu = json::parse(slurp(out / "meta.json")).at("emulator");
+  const json emu = json::parse(vmh::testing::read_file(out / "meta.json")).at("emulator");
   EXPECT_TRUE(emu.at("seeded_faults").empty());
   EXPECT_TRUE(emu.at("model").is_null());
 }
@@ -130,8 +124,8 @@ TEST(RunModel, SameOmniGivesTheSameRun) {
   ASSERT_EQ(a.exit_code, 0) << a.err;
   const auto b = run("run case1 --out " + without.string());
   ASSERT_EQ(b.exit_code, 0) << b.err;
-  const json sa = json::parse(slurp(with / "case1" / "summary.json"));
-  const json sb = json::parse(slurp(without / "case1" / "summary.json"));
+  const json sa = json::parse(vmh::testing::read_file(with / "case1" / "summary.json"));
+  const json sb = json::parse(vmh::testing::read_file(without / "case1" / "summary.json"));
   EXPECT_EQ(sa.at("model"), fs::absolute(kOmni).string());
   EXPECT_TRUE(sb.at("model").is_null());
   EXPECT_EQ(sa.at("metrics"), sb.at("metrics"));

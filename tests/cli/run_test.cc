@@ -145,10 +145,7 @@ TEST(RunCli, MalformedSceneIsNamedAndWritesNothing) {
 
 // case1.xml's text, to edit into another scene
 std::string case1_xml() {
-  std::ifstream in(std::string(VMH_MODELS_DIR) + "/cases/case1.xml");
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
+  return vmh::testing::read_file(std::string(VMH_MODELS_DIR) + "/cases/case1.xml");
 }
 
 // `xml` written as dir/cases/<name>. MuJoCo resolves includes relative to

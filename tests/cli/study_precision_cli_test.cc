@@ -60,9 +60,7 @@ TEST(StudyPrecisionCli, PrintsJsonAndWritesTableAndCharts) {
             0u);
   for (const char* svg : {"precision.svg", "precision_order.svg"}) {
     ASSERT_TRUE(fs::exists(out / svg)) << svg;
-    std::ifstream in(out / svg);
-    const std::string text((std::istreambuf_iterator<char>(in)),
-                           std::istreambuf_iterator<char>());
+    const std::string text = vmh::testing::read_file(out / svg);
     EXPECT_NE(text.find("<svg"), std::string::npos) << svg;
     EXPECT_NE(text.find("series-1"), std::string::npos) << svg;
   }

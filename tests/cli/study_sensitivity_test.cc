@@ -19,12 +19,6 @@ using vmh::testing::first_line;
 using vmh::testing::fresh_dir;
 using vmh::testing::run;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // the quick sweep of case 2 on a 2 s script (the claims' windows scale with
 // the script), so that the test takes seconds
@@ -84,7 +78,7 @@ TEST(StudySensitivityCli, QuickSweepAndItsShardsMerged) {
   ASSERT_EQ(m.exit_code, 0) << m.err;
   EXPECT_EQ(nlohmann::json::parse(m.out).at("claims"), printed.at("claims"));
   for (const char* f : {"sensitivity.json", "sensitivity.csv", "sensitivity.svg"}) {
-    EXPECT_EQ(slurp(merged / f), slurp(whole / f)) << f;
+    EXPECT_EQ(vmh::testing::read_file(merged / f), vmh::testing::read_file(whole / f)) << f;
   }
 
   // a shard missing, or one of another sweep: refused, nothing written
@@ -127,7 +121,7 @@ TEST(StudySensitivityCli, BadInputIsOneLineExit2NothingWritten) {
                               (file / "sub").string());
   EXPECT_EQ(unwritable.exit_code, 2);
   EXPECT_NE(unwritable.err.find("--out"), std::string::npos) << unwritable.err;
-  EXPECT_EQ(slurp(file), "x");
+  EXPECT_EQ(vmh::testing::read_file(file), "x");
 }
 
 }  // namespace

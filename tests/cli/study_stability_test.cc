@@ -20,12 +20,6 @@ fs::path stability_dir(const std::string& name) {
   return vmh::testing::fresh_dir("vmh_stability_", name);
 }
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 const char* const kBase = "study stability --mass 1 --damping 2 --servo-period 0.001 ";
 
@@ -77,7 +71,7 @@ TEST(StudyStabilityCli, OneTickDelayAndOutputs) {
   EXPECT_NEAR(j.at("k_bound_gil_N_per_m").get<double>(), bound, 1e-9);
   EXPECT_NEAR(j.at("k_crit_N_per_m").get<double>() / bound, 1.0, 0.05);
   EXPECT_DOUBLE_EQ(j.at("inputs").at("delay_s").get<double>(), 1e-3);
-  const std::string csv = read(out / "stability_bisection.csv");
+  const std::string csv = vmh::testing::read_file(out / "stability_bisection.csv");
   EXPECT_EQ(csv.rfind("run,k_N_per_m,stable,diverged,growth_rate_per_s,"
                       "early_peak_m,late_peak_m,ticks\n",
                       0),
@@ -85,7 +79,7 @@ TEST(StudyStabilityCli, OneTickDelayAndOutputs) {
   std::size_t rows = 0;
   for (char c : csv) rows += c == '\n' ? 1 : 0;
   EXPECT_EQ(rows, 1u + j.at("iterations").at("sim_runs").get<std::size_t>());
-  EXPECT_EQ(read(out / "stability_bisection.svg").rfind("<svg", 0), 0u);
+  EXPECT_EQ(vmh::testing::read_file(out / "stability_bisection.svg").rfind("<svg", 0), 0u);
   EXPECT_EQ(j.at("outputs").size(), 2u);
 }
 
@@ -101,13 +95,13 @@ TEST(StudyStabilityCli, MapWritesTableAndChart) {
   EXPECT_EQ(j.at("virtual_damping_Ns_per_m"), nlohmann::json({0.0, 4.0}));
   EXPECT_EQ(j.at("delay_ticks"), nlohmann::json({1}));
   EXPECT_LT(j.at("max_abs_rel_error_sim_vs_exact").get<double>(), 0.01);
-  const std::string csv = read(out / "stability_map.csv");
+  const std::string csv = vmh::testing::read_file(out / "stability_map.csv");
   EXPECT_EQ(csv.rfind("virtual_damping_Ns_per_m,delay_ticks,"
                       "k_crit_sim_N_per_m,",
                       0),
             0u);
   EXPECT_NE(csv.find("\n4,1,"), std::string::npos);
-  const std::string svg = read(out / "stability_map.svg");
+  const std::string svg = vmh::testing::read_file(out / "stability_map.svg");
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   EXPECT_NE(svg.find("simulated, n = 1"), std::string::npos);
 }

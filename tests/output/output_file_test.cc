@@ -15,6 +15,8 @@
 #include <thread>
 #include <vector>
 
+#include "tests/support/read_file.h"
+
 namespace vmh::output {
 namespace {
 
@@ -26,12 +28,6 @@ fs::path fresh(const std::string& name) {
   return d;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // the names in a folder
 std::set<std::string> names(const fs::path& d) {
@@ -45,7 +41,7 @@ TEST(WriteFileAtomically, WritesAndLeavesNoTemporary) {
   fs::create_directories(d);
   write_file_atomically((d / "a.txt").string(), "one");
   write_file_atomically((d / "a.txt").string(), "two");
-  EXPECT_EQ(slurp(d / "a.txt"), "two");
+  EXPECT_EQ(vmh::testing::read_file(d / "a.txt"), "two");
   EXPECT_EQ(names(d), std::set<std::string>({"a.txt"}));
 }
 
@@ -82,7 +78,7 @@ TEST(WriteFileAtomically, ReplacesOnlyARegularFile) {
   EXPECT_TRUE(fs::is_fifo(d / "fifo"));
   EXPECT_TRUE(fs::is_directory(d / "folder"));
   EXPECT_TRUE(fs::is_symlink(d / "link"));
-  EXPECT_EQ(slurp(d / "target"), "kept");
+  EXPECT_EQ(vmh::testing::read_file(d / "target"), "kept");
   // nothing else was left: no temporary beside them
   EXPECT_EQ(names(d), std::set<std::string>({"fifo", "folder", "link", "target"}));
   // /dev/null is a device: refused by type, never opened for the rename
@@ -111,7 +107,7 @@ TEST(OutputSet, FirstSetIsRenamedIntoPlace) {
   }
   EXPECT_EQ(names(d), std::set<std::string>({"case1"}));
   EXPECT_EQ(names(d / "case1"), std::set<std::string>({"a.txt", "b.txt"}));
-  EXPECT_EQ(slurp(d / "case1" / "a.txt"), "A");
+  EXPECT_EQ(vmh::testing::read_file(d / "case1" / "a.txt"), "A");
 }
 
 // "out/" and "./out" name the folder "out" (a trailing '/' made the set
@@ -125,7 +121,7 @@ TEST(OutputSet, ATrailingSlashIsTheSameFolderAndDotIsRefused) {
     set.commit();
   }
   EXPECT_EQ(names(d), std::set<std::string>({"out"}));
-  EXPECT_EQ(slurp(d / "out" / "a.txt"), "A");
+  EXPECT_EQ(vmh::testing::read_file(d / "out" / "a.txt"), "A");
   {
     OutputSet set((d / "." / "out" / "x" / "..").string() + "//");
     set.write("b.txt", "B");
@@ -156,12 +152,12 @@ TEST(OutputSet, ASecondSetReplacesTheFirstWhole) {
     OutputSet set((d / "case1").string());
     set.write("a.txt", "new A");
     // the previous set stays whole until the commit
-    EXPECT_EQ(slurp(d / "case1" / "a.txt"), "old A");
+    EXPECT_EQ(vmh::testing::read_file(d / "case1" / "a.txt"), "old A");
     set.commit();
   }
   EXPECT_EQ(names(d), std::set<std::string>({"case1"}));
   EXPECT_EQ(names(d / "case1"), std::set<std::string>({"a.txt"}));
-  EXPECT_EQ(slurp(d / "case1" / "a.txt"), "new A");
+  EXPECT_EQ(vmh::testing::read_file(d / "case1" / "a.txt"), "new A");
 }
 
 // an error part way (here a file that cannot be made; ENOSPC takes the same
@@ -185,7 +181,7 @@ TEST(OutputSet, AFailedSetLeavesThePreviousOneAndNoTemporary) {
               (d / "case1" / "no" / "b.txt").string() + ": No such file or directory");
   }
   EXPECT_EQ(names(d), std::set<std::string>({"case1"}));
-  EXPECT_EQ(slurp(d / "case1" / "a.txt"), "old A");
+  EXPECT_EQ(vmh::testing::read_file(d / "case1" / "a.txt"), "old A");
 }
 
 TEST(OutputSet, WithoutCommitNothingIsLeft) {
@@ -222,7 +218,7 @@ TEST(OutputSet, ConcurrentWritersLeaveOneWholeSet) {
   for (const std::string& e : errors) EXPECT_EQ(e, "");
   EXPECT_EQ(names(d), std::set<std::string>({"case1"}));
   EXPECT_EQ(names(d / "case1"), std::set<std::string>({"a.txt", "b.txt"}));
-  EXPECT_EQ(slurp(d / "case1" / "a.txt"), slurp(d / "case1" / "b.txt"));
+  EXPECT_EQ(vmh::testing::read_file(d / "case1" / "a.txt"), vmh::testing::read_file(d / "case1" / "b.txt"));
 }
 
 // the check leaves things as they were: no probe, and no folder it made

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <ostream>
 #include <sstream>
@@ -25,6 +26,7 @@
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/temp_mjcf.h"
 #include "tests/support/constants.h"
+#include "tests/support/read_file.h"
 
 namespace vmh::sim {
 namespace {
@@ -701,16 +703,15 @@ TEST(CaseParamTable, RowsAreUniqueAndBound) {
 // docs/parameters.md is the program's table, verbatim (regenerate it with
 // `build/vmhaptics params > docs/parameters.md`).
 TEST(CaseParamTable, DocsAreTheGeneratedTable) {
-  std::ifstream in(std::string(VMH_MODELS_DIR) + "/../docs/parameters.md");
-  ASSERT_TRUE(in.good());
-  std::stringstream text;
-  text << in.rdbuf();
-  EXPECT_EQ(text.str(), parameters_markdown())
+  const std::string doc = std::string(VMH_MODELS_DIR) + "/../docs/parameters.md";
+  ASSERT_TRUE(std::filesystem::is_regular_file(doc)) << doc;
+  const std::string text = vmh::testing::read_file(doc);
+  EXPECT_EQ(text, parameters_markdown())
       << "docs/parameters.md is stale: run build/vmhaptics params > "
          "docs/parameters.md";
   // and it has a row for every parameter
   for (const ParamSpec& f : case_fields()) {
-    EXPECT_NE(text.str().find(std::string("| `") + f.name + "` |"),
+    EXPECT_NE(text.find(std::string("| `") + f.name + "` |"),
               std::string::npos)
         << f.name;
   }

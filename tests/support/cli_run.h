@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/read_file.h"
+
 namespace vmh::testing {
 
 struct CliRun {
@@ -81,21 +83,6 @@ inline std::filesystem::path fresh_dir(const std::string& prefix,
   return d;
 }
 
-// a whole file, as its bytes ("" if it cannot be read)
-inline std::string read_file(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// the first line of a text file ("" if it cannot be read)
-inline std::string first_line(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
 
 }  // namespace vmh::testing
 

@@ -13,6 +13,7 @@
 
 #include "sim/closed_loop.h"
 #include "tests/support/temp_mjcf.h"
+#include "tests/support/read_file.h"
 #include "viz/gl_context.h"
 #include "viz/overlay.h"
 #include "viz/render.h"
@@ -37,12 +38,6 @@ fs::path fresh_dir(const std::string& name) {
   return d;
 }
 
-std::string slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 RenderRequest request(const fs::path& out) {
   RenderRequest r;
@@ -62,7 +57,7 @@ TEST(Render, SameRequestGivesByteIdenticalFiles) {
   ASSERT_EQ(ia.size(), 2u);
   ASSERT_EQ(ib.size(), 2u);
   for (std::size_t i = 0; i < ia.size(); ++i) {
-    const std::string fa = slurp(ia[i].path), fb = slurp(ib[i].path);
+    const std::string fa = vmh::testing::read_file(ia[i].path), fb = vmh::testing::read_file(ib[i].path);
     EXPECT_EQ(fs::path(ia[i].path).filename(), fs::path(ib[i].path).filename());
     EXPECT_EQ(fa.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
     EXPECT_GT(fa.size(), 1000u);
@@ -85,7 +80,7 @@ TEST(Render, TheArmMovesBetweenTimes) {
   r.label = false;
   const std::vector<RenderedImage> im = vmh::viz::render(r);
   ASSERT_EQ(im.size(), 2u);
-  EXPECT_NE(slurp(im[0].path), slurp(im[1].path));
+  EXPECT_NE(vmh::testing::read_file(im[0].path), vmh::testing::read_file(im[1].path));
   // at 0.5 s the hand rests on the path, at 2.5 s it has pulled off it
   EXPECT_LT(im[0].d_path_mm, 1.0);
   EXPECT_GT(im[1].d_path_mm, 5.0);
@@ -237,7 +232,7 @@ TEST(SceneRenderer, NamedCameraIsUsed) {
   fs::create_directory_symlink(fs::path(VMH_MODELS_DIR) / "omni", dir / "omni");
   fs::create_directory_symlink(fs::path(VMH_MODELS_DIR) / "hand", dir / "hand");
   fs::create_directories(dir / "cases");
-  std::string xml = slurp(kCase1);
+  std::string xml = vmh::testing::read_file(kCase1);
   const std::size_t end = xml.rfind("</mujoco>");
   ASSERT_NE(end, std::string::npos);
   xml.insert(end,
@@ -253,10 +248,10 @@ TEST(SceneRenderer, NamedCameraIsUsed) {
   r.scene_path = scene.string();
   r.times_s = {0.5};
   const RenderedImage free_view = vmh::viz::render(r).at(0);
-  const std::string free_png = slurp(free_view.path);
+  const std::string free_png = vmh::testing::read_file(free_view.path);
   r.camera = "above";
   const RenderedImage above = vmh::viz::render(r).at(0);
-  EXPECT_NE(slurp(above.path), free_png);
+  EXPECT_NE(vmh::testing::read_file(above.path), free_png);
 
   r.camera = "missing";
   try {
