@@ -174,33 +174,46 @@ void check_writable_dir(const std::string& dir) {
   if (fs::exists(st) && !fs::is_directory(st)) {
     throw std::runtime_error(dir + ": " + os_error(ENOTDIR));
   }
-  // the folders this check makes, deepest first, to be taken away again:
-  // a run refused later for bad input leaves nothing behind
-  std::vector<fs::path> made;
-  for (fs::path p = fs::path(dir); !p.empty() && !fs::exists(fs::symlink_status(p, ec));
-       p = p.parent_path()) {
-    made.push_back(p);
-    if (p == p.parent_path()) break;
-  }
-  const auto unmake = [&made] {
-    // rmdir only: a folder another run has written in meanwhile stays
-    for (const fs::path& p : made) rmdir(p.c_str());
-  };
-  fs::create_directories(dir, ec);
-  if (ec) {
+  // Another process's check of the same new folder (two runs into one new
+  // --out) takes away the folders it made, possibly between this check's
+  // making them (or finding them) and its probe, or inside
+  // create_directories (which then reports EEXIST for a folder that was
+  // there when it looked and gone when it checked): the attempt is made
+  // again on ENOENT or EEXIST, a bounded number of times.
+  constexpr int kAttempts = 50;
+  for (int attempt = 1;; ++attempt) {
+    // the folders this attempt makes, deepest first, to be taken away
+    // again: a run refused later for bad input leaves nothing behind
+    std::vector<fs::path> made;
+    for (fs::path p = fs::path(dir); !p.empty() && !fs::exists(fs::symlink_status(p, ec));
+         p = p.parent_path()) {
+      made.push_back(p);
+      if (p == p.parent_path()) break;
+    }
+    const auto unmake = [&made] {
+      // rmdir only: a folder another run has written in meanwhile stays
+      for (const fs::path& p : made) rmdir(p.c_str());
+    };
+    int err = 0;
+    fs::create_directories(dir, ec);
+    if (ec) {
+      err = ec.value();
+    } else {
+      std::string probe = (fs::path(dir) / ".vmh-probe-XXXXXX").string();
+      const int fd = mkstemp(probe.data());
+      if (fd >= 0) {
+        close(fd);
+        unlink(probe.c_str());
+        unmake();
+        return;
+      }
+      err = errno;
+    }
     unmake();
-    throw std::runtime_error(dir + ": " + ec.message());
+    if ((err != ENOENT && err != EEXIST) || attempt == kAttempts) {
+      throw std::runtime_error(dir + ": " + os_error(err));
+    }
   }
-  std::string probe = (fs::path(dir) / ".vmh-probe-XXXXXX").string();
-  const int fd = mkstemp(probe.data());
-  if (fd < 0) {
-    const int err = errno;
-    unmake();
-    throw std::runtime_error(dir + ": " + os_error(err));
-  }
-  close(fd);
-  unlink(probe.c_str());
-  unmake();
 }
 
 OutputSet::OutputSet(const std::string& dest) {

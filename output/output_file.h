@@ -61,8 +61,10 @@ std::string write_file_in(const std::string& dir, const std::string& name,
 // Checks that `dir` is a folder this process can write in: creates it (and
 // its parents) if needed, creates and removes a probe file in it, then
 // removes the folders it created (the writers create them again), so that
-// the check itself leaves nothing. Throws std::runtime_error "<dir>: <the
-// OS's reason>" (e.g. "Not a directory", "Permission denied") otherwise.
+// the check itself leaves nothing. Checks of one new folder may run at
+// once (two runs into one new --out): a folder another check took away
+// meanwhile is made again. Throws std::runtime_error "<dir>: <the OS's
+// reason>" (e.g. "Not a directory", "Permission denied") otherwise.
 void check_writable_dir(const std::string& dir);
 
 // A folder's files written as one set: they go into a private temporary

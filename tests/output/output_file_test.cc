@@ -218,7 +218,8 @@ TEST(OutputSet, ConcurrentWritersLeaveOneWholeSet) {
   for (const std::string& e : errors) EXPECT_EQ(e, "");
   EXPECT_EQ(names(d), std::set<std::string>({"case1"}));
   EXPECT_EQ(names(d / "case1"), std::set<std::string>({"a.txt", "b.txt"}));
-  EXPECT_EQ(vmh::testing::read_file(d / "case1" / "a.txt"), vmh::testing::read_file(d / "case1" / "b.txt"));
+  EXPECT_EQ(vmh::testing::read_file(d / "case1" / "a.txt"),
+            vmh::testing::read_file(d / "case1" / "b.txt"));
 }
 
 // the check leaves things as they were: no probe, and no folder it made
@@ -229,6 +230,32 @@ TEST(CheckWritableDir, LeavesNoProbeAndNoFolderItMade) {
   EXPECT_TRUE(names(d).empty());
   check_writable_dir((d / "a" / "b").string());
   EXPECT_TRUE(names(d).empty());
+}
+
+// checks of one new folder at once, as two runs into one new --out make
+// them: every one passes. Each check takes away the folders it made, so a
+// check that found the folder there can see it vanish before its probe;
+// it then makes it again instead of failing ("No such file or directory",
+// seen with two runs under load)
+TEST(CheckWritableDir, ConcurrentChecksOfOneNewFolderAllPass) {
+  const fs::path d = fresh("check_concurrent");
+  const std::string target = (d / "out" / "sub").string();
+  std::vector<std::thread> threads;
+  std::vector<std::string> errors(8);
+  for (int t = 0; t < 8; ++t) {
+    threads.emplace_back([&, t] {
+      for (int i = 0; i < 300; ++i) {
+        try {
+          check_writable_dir(target);
+        } catch (const std::exception& e) {
+          errors[static_cast<std::size_t>(t)] = e.what();
+          return;
+        }
+      }
+    });
+  }
+  for (std::thread& th : threads) th.join();
+  for (const std::string& e : errors) EXPECT_EQ(e, "");
 }
 
 TEST(CheckWritableDir, NamesAFileOrAPathUnderAFile) {
