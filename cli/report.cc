@@ -131,11 +131,10 @@ void run(const ReportCli& o) {
     return std::optional<std::string>();
   };
 #endif
-  const fs::path study_dir = fs::path(o.out) / "study";
-  std::error_code ec;
-  fs::create_directories(study_dir, ec);
-  if (ec || !fs::is_directory(study_dir)) {
-    throw UsageError("--out: cannot create directory '" + study_dir.string() + "'");
+  try {
+    studies::make_report_folders(job);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--out: ") + e.what());
   }
   const studies::ReportOutcome r = studies::make_report(job);
 

@@ -205,6 +205,15 @@ ReportStudies rj_studies(const fs::path& study_dir, const PrecisionOptions& prec
 
 }  // namespace
 
+void make_report_folders(const ReportJob& job) {
+  const fs::path study_dir = fs::path(job.out_dir) / "study";
+  std::error_code ec;
+  fs::create_directories(study_dir, ec);
+  if (ec || !fs::is_directory(study_dir)) {
+    throw std::invalid_argument("cannot create directory '" + study_dir.string() + "'");
+  }
+}
+
 ReportOutcome make_report(const ReportJob& job) {
   if (job.jobs < 1) {
     throw std::invalid_argument("report: jobs must be >= 1, got " +
@@ -217,11 +226,7 @@ ReportOutcome make_report(const ReportJob& job) {
   const auto start = std::chrono::steady_clock::now();
   const fs::path dir(job.out_dir);
   const fs::path study_dir = dir / "study";
-  std::error_code ec;
-  fs::create_directories(study_dir, ec);
-  if (ec || !fs::is_directory(study_dir)) {
-    throw std::invalid_argument("cannot create directory '" + study_dir.string() + "'");
-  }
+  make_report_folders(job);
 
   RjPlan plan = rj_plan(job, dir, study_dir);
   const PrecisionOptions precision = rj_precision_options(job, study_dir);

@@ -47,6 +47,13 @@ struct ReportOutcome {
   double wall_s = 0.0;  // the job, first to last
 };
 
+// Makes the job's folders (out_dir and out_dir/study). Throws
+// std::invalid_argument "cannot create directory '<out_dir>/study'" when
+// they cannot be made or are not folders. make_report() calls it first; a
+// caller that refuses such a folder as bad input before anything else
+// (the command line: exit 2) calls it itself.
+void make_report_folders(const ReportJob& job);
+
 // Runs the job. Throws std::invalid_argument for jobs < 1, an empty
 // out_dir, no render or a folder that cannot be made (naming it);
 // std::runtime_error naming the case or file for a run that failed or a

@@ -11,8 +11,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -44,10 +42,7 @@ inline CliRun run(const std::string& args, const std::string& env = "") {
   while ((n = fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
   const int status = pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream err(err_path);
-  std::stringstream ss;
-  ss << err.rdbuf();
-  r.err = ss.str();
+  r.err = read_file(err_path);
   std::remove(err_path.c_str());
   return r;
 }
@@ -82,7 +77,6 @@ inline std::filesystem::path fresh_dir(const std::string& prefix,
   std::filesystem::remove_all(d);
   return d;
 }
-
 
 }  // namespace vmh::testing
 
