@@ -34,7 +34,7 @@
 #include "output/svg_chart.h"
 #include "bringup/identify.h"
 #include "bringup/recording.h"
-#include "studies/run_case.h"
+#include "sim/case_catalogue.h"
 
 namespace vmh::cli {
 namespace {
