@@ -157,7 +157,7 @@ void BM_controller_tick(benchmark::State& state, VmKind kind,
 // is the device z axis (the surface's normal). q1..q3 come from the IK
 // (nearest the previous sample), outside any timed region.
 const std::vector<Joints>& on_path(VmKind kind) {
-  static std::vector<Joints> sets[3];
+  static std::vector<Joints> sets[4];
   std::vector<Joints>& set = sets[static_cast<int>(kind)];
   if (!set.empty()) return set;
   const OmniParams params;
@@ -185,6 +185,11 @@ const std::vector<Joints>& on_path(VmKind kind) {
       case VmKind::kSurface: {
         p_mm = Vec3(30.0 * std::cos(a), 30.0 * std::sin(a),
                     kLength_mm - 2.0 + wobble_mm);
+        break;
+      }
+      case VmKind::kLine: {
+        // back and forth along the line (the device y axis), 2 mm off it
+        p_mm = Vec3(2.0 + wobble_mm, 40.0 * std::sin(a), wobble_mm);
         break;
       }
     }
@@ -282,7 +287,8 @@ void BM_rm_kinematics(benchmark::State& state) {
 }
 
 void register_benchmarks() {
-  const VmKind kinds[] = {VmKind::kCircle, VmKind::kSphere, VmKind::kSurface};
+  std::vector<VmKind> kinds;
+  for (const VmDescriptor& d : vm_registry()) kinds.push_back(d.kind);
   const PlacementMethod placements[] = {PlacementMethod::kGaussNewton,
                                         PlacementMethod::kClosedForm};
   auto add_tick = [](VmKind kind, PlacementMethod placement,

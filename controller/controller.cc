@@ -9,6 +9,7 @@
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
 #include "controller/trig.h"
+#include "controller/vm_registry.h"
 
 namespace vmh {
 namespace {
@@ -157,17 +158,7 @@ Controller::Controller(const ControllerParams& params) : params_(params) {
   mount.origin = params_.vm.pivot_mm / u;
   mount.R = params_.vm.R_pivot;
   const double L = params_.vm.length_mm / u;
-  switch (params_.vm.kind) {
-    case VmKind::kCircle:
-      vm_ = std::make_unique<CircleVm>(mount, L);
-      break;
-    case VmKind::kSphere:
-      vm_ = std::make_unique<SphereVm>(mount, L);
-      break;
-    case VmKind::kSurface:
-      vm_ = std::make_unique<SurfaceVm>(mount, L);
-      break;
-  }
+  vm_ = make_vm(params_.vm.kind, mount, L);
   // eq. 3.28 in the controller's unit u: N/u for position, N u/rad for
   // orientation
   const Gains& g = params_.gains;

@@ -34,6 +34,7 @@
 #include "controller/omni_kinematics.h"
 #include "controller/omni_params.h"
 #include "controller/virtual_mechanism.h"
+#include "controller/vm_registry.h"
 
 namespace vmh {
 

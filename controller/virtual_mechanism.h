@@ -3,16 +3,21 @@
 //
 // A VM has m joint coordinates theta (m <= 5), a handle pose X_V(theta) and a
 // 6 x m Jacobian J_V whose rows are the handle's linear velocity (rows 0-2)
-// and angular velocity (rows 3-5), both in the device frame. Three VMs are
-// provided:
-//   CircleVm  - 1 DOF: a link of length L turning about a pivot in a plane
-//               (eq. 3.25-3.27). Appendix D puts the plane in the device x-y
-//               plane; here the plane is the pivot frame's x-y plane.
-//   SphereVm  - 3 DOF: a link of length L on a ball joint at the pivot
-//               (eq. 3.29-3.31); theta = (azimuth, polar, twist).
-//   SurfaceVm - 5 DOF: a probe whose tip slides on a plane (two prismatic
-//               joints) with a ball joint at the tip (three revolute joints),
-//               thesis §3.1. theta = (s1, s2, alpha, beta, gamma).
+// and angular velocity (rows 3-5), both in the device frame. This header is
+// the interface; each mechanism has its own files, and
+// controller/vm_registry.h lists them once (name, factory, prediction):
+//   CircleVm  (vm_circle.h)  - 1 DOF: a link of length L turning about a
+//               pivot in a plane (eq. 3.25-3.27). Appendix D puts the plane
+//               in the device x-y plane; here it is the pivot frame's x-y.
+//   SphereVm  (vm_sphere.h)  - 3 DOF: a link of length L on a ball joint at
+//               the pivot (eq. 3.29-3.31); theta = (azimuth, polar, twist).
+//   SurfaceVm (vm_surface.h) - 5 DOF: a probe whose tip slides on a plane
+//               (two prismatic joints) with a ball joint at the tip (three
+//               revolute joints), thesis §3.1. theta = (s1, s2, alpha, beta,
+//               gamma).
+//   LineVm    (vm_line.h)    - 1 DOF: a handle sliding on a straight line,
+//               the circle's limit as its radius grows (this project's
+//               addition, docs/control.md).
 //
 // Units: the mechanisms do not know about units. Every length (pivot, L,
 // positions, prismatic coordinates) is in one length unit chosen by the
@@ -31,6 +36,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "controller/types.h"
 
@@ -44,7 +50,9 @@ using VmAngles =
 using VmJacobian =
     Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::ColMajor, 6, kMaxVmDof>;
 
-enum class VmKind { kCircle, kSphere, kSurface };
+// Which mechanism; controller/vm_registry.cc gives each its name and
+// factory. Adding one is a value here, a row there, and its own files.
+enum class VmKind { kCircle, kSphere, kSurface, kLine };
 
 // a set of VM joints, bit j for joint j (e.g. locked during placement)
 using JointMask = std::uint32_t;
@@ -55,11 +63,6 @@ enum class ContactState {
   kSliding,  // it sticks no longer: the force left the friction cone
   kOpen,     // unilateral contact pulled on: the probe lifts off
 };
-
-// "circle", "sphere", "surface"
-const char* vm_kind_name(VmKind kind);
-// parses the names above; false for anything else
-bool parse_vm_kind(const char* text, VmKind* kind);
 
 // What a VM sees of the real manipulator (RM): the wrist-centre position and
 // the unit stylus axis, both in the device frame (position in the caller's
@@ -85,6 +88,52 @@ struct VmPose {
 struct VmMount {
   Vec3 origin = Vec3::Zero();
   Mat3 R = Mat3::Identity();
+};
+
+// The path's shape, for figures and the viewer (drawing hook): primitives
+// the drawing code knows, so a new mechanism made of them draws with no
+// change there. Device frame, the VM's length unit.
+struct PathPrimitive {
+  enum class Type {
+    kCircle,  // centre, in-plane unit axes u and v, radius
+    kSphere,  // centre, radius (figures draw its outline)
+    kLine,    // through centre along the unit u, unbounded
+    kPlane,   // through centre, spanned by the unit u and v (unbounded);
+              // the handle moves `radius` to either side of it
+  };
+  Type type = Type::kCircle;
+  Vec3 centre = Vec3::Zero();
+  Vec3 u = Vec3::UnitX();
+  Vec3 v = Vec3::UnitY();
+  double radius = 0.0;
+};
+
+// How the thesis's scripted experiments (ch. 4, sim/hand_script.h) hold the
+// hand on this VM, device frame: the start point on the path; the unit
+// direction "outward" from the path there (the off-path holds move along
+// it); the unit tangent of the path there; the stylus axis held there
+// (unless the case sets one); and the unit axis the second on-path hold
+// tilts the stylus about (by +script_misalign_rad).
+struct PathStart {
+  Vec3 p = Vec3::Zero();
+  Vec3 outward = Vec3::UnitX();
+  Vec3 tangent = Vec3::UnitY();
+  Vec3 axis = Vec3::UnitX();
+  Vec3 tilt_b = Vec3::UnitY();
+};
+
+// What the law acts on at a static pose, worked out by a route apart from
+// the servo tick's (each VM's prediction hook, controller/vm_registry.h,
+// used by studies/law_prediction.h): from the wrist centre and the stylus
+// axis alone, in closed form, the nearest point of the path x_v, the handle
+// turned onto the stylus x_r, the orientation error (the thesis's or the
+// geometric, device frame, rad) and J_V at x_v built from the geometry, not
+// from joint angles. Device frame, the VM's length unit.
+struct VmStaticPlacement {
+  Vec3 x_v = Vec3::Zero();
+  Vec3 x_r = Vec3::Zero();
+  Vec3 e_ornt_rad = Vec3::Zero();
+  VmJacobian J;
 };
 
 class VirtualMechanism {
@@ -217,6 +266,29 @@ class VirtualMechanism {
     return false;
   }
 
+  // ---- hooks for what is built on the controller (not the servo tick)
+
+  // The path as drawing primitives (figures, viewer).
+  virtual std::vector<PathPrimitive> path_primitives() const = 0;
+  // Whether the path lies in the pivot frame's x-y plane (the figures then
+  // draw it in that plane's view alone).
+  virtual bool planar() const { return false; }
+
+  // The scripts' start toward the unit device-frame direction `dir` from
+  // the mount; false where `dir` names none (along the circle's normal).
+  // The default (the sphere's): origin + L dir, outward along dir, the
+  // tangent about the pivot frame's z axis, the stylus along dir, tilted
+  // about the tangent.
+  virtual bool path_start(const Vec3& dir, PathStart* out) const;
+  // The sweep's motion: the handle moved along the path from the start s
+  // by the angle phi (rad) and `across` (length unit) outward of it, *p,
+  // with the rotation *turn the stylus turns by there. The default turns
+  // about the pivot frame's z axis through the origin by phi, at the radius
+  // L + across: the circle's and the sphere's motion. (A straight path
+  // slides by the same arc, L phi.)
+  virtual void along_path(const PathStart& s, double phi, double across,
+                          Vec3* p, Mat3* turn) const;
+
   // a VmAngles of size dof(), zero
   VmAngles zero_angles() const;
   // the angles before any placement (zero, or the surface's upright probe)
@@ -228,117 +300,6 @@ class VirtualMechanism {
  protected:
   VmMount mount_;
   double length_;
-};
-
-class CircleVm final : public VirtualMechanism {
- public:
-  CircleVm(const VmMount& mount, double length);
-  VmKind kind() const override { return VmKind::kCircle; }
-  int dof() const override { return 1; }
-  VmPose pose(const VmAngles& theta) const override;
-  void jacobian(const VmAngles& theta, VmJacobian* J) const override;
-  void pose_jacobian(const VmAngles& theta, VmPose* pose,
-                     VmJacobian* J) const override;
-  Vec3 position(const VmAngles& theta) const override;
-  bool nearest(const RmPose& rm, VmAngles* theta) const override;
-  bool aligned(const RmPose& rm, VmAngles* theta) const override;
-  bool nearest_pose_jacobian(const RmPose& rm, VmAngles* theta, VmPose* pose,
-                             VmJacobian* J) const override;
-  bool nearest_minimises_distance() const override { return true; }
-  bool aligned_position(const RmPose& rm, VmAngles* theta,
-                        Vec3* p) const override;
-  Vec3 thesis_orientation_error(const VmAngles& theta_v,
-                                const VmAngles& theta_r) const override;
-  Vec3 geometric_orientation_error(const VmPose& vm, const RmPose& rm,
-                                   bool* ambiguous) const override;
-  Mat3 orientation_error_jacobian(const VmPose& vm,
-                                  const RmPose& rm) const override;
-  bool is_revolute(int) const override { return true; }
-  void normalize(VmAngles* theta) const override;
-  double distance_to_path(const Vec3& p) const override;
-  Vec3 nearest_on_path(const Vec3& p) const override;
-};
-
-class SphereVm final : public VirtualMechanism {
- public:
-  SphereVm(const VmMount& mount, double length);
-  VmKind kind() const override { return VmKind::kSphere; }
-  int dof() const override { return 3; }
-  VmPose pose(const VmAngles& theta) const override;
-  void jacobian(const VmAngles& theta, VmJacobian* J) const override;
-  void pose_jacobian(const VmAngles& theta, VmPose* pose,
-                     VmJacobian* J) const override;
-  Vec3 position(const VmAngles& theta) const override;
-  bool nearest(const RmPose& rm, VmAngles* theta) const override;
-  bool aligned(const RmPose& rm, VmAngles* theta) const override;
-  bool nearest_pose_jacobian(const RmPose& rm, VmAngles* theta, VmPose* pose,
-                             VmJacobian* J) const override;
-  bool nearest_minimises_distance() const override { return true; }
-  bool aligned_position(const RmPose& rm, VmAngles* theta,
-                        Vec3* p) const override;
-  Vec3 thesis_orientation_error(const VmAngles& theta_v,
-                                const VmAngles& theta_r) const override;
-  bool is_revolute(int) const override { return true; }
-  void normalize(VmAngles* theta) const override;
-  double distance_to_path(const Vec3& p) const override;
-  Vec3 nearest_on_path(const Vec3& p) const override;
-};
-
-// The plane passes through mount.origin with normal mount.R.col(2); the
-// prismatic joints slide along mount.R.col(0) and col(1). The link direction
-// is u = cos(beta) t1 + sin(beta) (cos(alpha) t2 + sin(alpha) n), so the
-// probe standing upright (u = n) is at alpha = beta = pi/2, far from the
-// parametrisation's poles (u = +-t1, the probe lying in the plane).
-class SurfaceVm final : public VirtualMechanism {
- public:
-  SurfaceVm(const VmMount& mount, double length);
-  VmKind kind() const override { return VmKind::kSurface; }
-  int dof() const override { return 5; }
-  VmPose pose(const VmAngles& theta) const override;
-  void jacobian(const VmAngles& theta, VmJacobian* J) const override;
-  // nearest: keeps the contact point and turns the probe toward the RM
-  // (the sticking probe); aligned: turns the probe onto the stylus axis and
-  // slides the contact under the stylus tip, p - L * axis projected on the
-  // plane
-  bool nearest(const RmPose& rm, VmAngles* theta) const override;
-  bool aligned(const RmPose& rm, VmAngles* theta) const override;
-  Vec3 thesis_orientation_error(const VmAngles& theta_v,
-                                const VmAngles& theta_r) const override;
-  bool is_revolute(int joint) const override { return joint >= 2; }
-  void normalize(VmAngles* theta) const override;
-  // the handle positions with the probe upright: L above or below the plane
-  double distance_to_path(const Vec3& p) const override;
-  Vec3 nearest_on_path(const Vec3& p) const override;
-  bool has_contact() const override { return true; }
-  // the prismatic joints s1, s2: the contact point
-  JointMask stick_joints() const override { return 3u; }
-  // kOpen if unilateral and f_N . n < 0 (the plane would have to pull the
-  // probe toward it; the handle stands on the +n side); kSliding if
-  // sticking and the tangential part exceeds mu |f_n| (plus a floor of
-  // 1e-6 N that keeps rounding-level forces at rest from creeping the
-  // contact); kClosed otherwise
-  ContactState contact_state(const Vec3& f_N, double mu, bool unilateral,
-                             bool sticking) const override;
-  // the probe upright (alpha = beta = pi/2), the contact at the origin
-  VmAngles rest_angles() const override;
-  // The placement cost reduces to one angle (docs/control.md): with the
-  // contact free, the best contact leaves only the normal part of the
-  // position residual, h - L u.n (h the RM's height over the plane); with it
-  // held at c, the position part depends on u only through u.d (d = p - c).
-  // Either way, for a fixed angle psi between u and n (or d), the angle phi
-  // between u and the stylus axis is smallest, |psi - psi_a|, with u in the
-  // plane of n (or d) and the axis. So u = cos psi n + sin psi t, and psi
-  // minimises w_pos (h - L cos psi)^2 + w_ornt (psi - psi_a)^2 (free), or
-  // -2 w_pos L |d| cos psi + w_ornt (psi - psi_a)^2 (held), by safeguarded
-  // Newton from *theta's psi. False where w_ornt = 0 (a family of minima),
-  // the axis lies along n (or d) (no plane), or the RM sits on the contact.
-  bool placement_minimum(const RmPose& rm, double w_pos, double w_ornt,
-                         bool contact_held, VmAngles* theta) const override;
-
-  // the contact point (device frame) for theta
-  Vec3 contact(const VmAngles& theta) const;
-  // unit normal of the plane (device frame)
-  Vec3 normal() const { return mount_.R.col(2); }
 };
 
 }  // namespace vmh

@@ -15,6 +15,11 @@
 #include "controller/controller.h"
 #include "controller/omni_kinematics.h"
 #include "controller/virtual_mechanism.h"
+#include "controller/vm_circle.h"
+#include "controller/vm_line.h"
+#include "controller/vm_registry.h"
+#include "controller/vm_sphere.h"
+#include "controller/vm_surface.h"
 #include "tests/support/constants.h"
 
 namespace vmh {

@@ -17,6 +17,11 @@
 
 #include "controller/omni_kinematics.h"  // wrap_angle
 #include "controller/virtual_mechanism.h"
+#include "controller/vm_circle.h"
+#include "controller/vm_line.h"
+#include "controller/vm_registry.h"
+#include "controller/vm_sphere.h"
+#include "controller/vm_surface.h"
 #include "tests/support/random_vm.h"
 #include "tests/support/vm_cases.h"
 #include "tests/support/constants.h"
@@ -38,7 +43,7 @@ using Eigen::VectorXd;
 
 // a dynamic copy: the checks run on plain dynamic matrices (GCC 12 warns
 // falsely inside Eigen reductions over the fixed-capacity VmJacobian)
-MatrixXd X(const VmJacobian& J) { return J; }
+MatrixXd dynamic_copy(const VmJacobian& J) { return J; }
 
 // the cost r^T W r, from the residual
 double cost_at(const VirtualMechanism& vm, const RmPose& rm, const Vec6& w,
@@ -55,7 +60,7 @@ double optimality(const VirtualMechanism& vm, const RmPose& rm, const Vec6& w,
   VmJacobian J;
   vm.jacobian(theta, &J);
   const Vec6 Wr = w.cwiseProduct(placement_residual(vm, rm, theta));
-  return (X(J).transpose() * Wr).norm() / (J.norm() * Wr.norm() + 1e-300);
+  return (dynamic_copy(J).transpose() * Wr).norm() / (J.norm() * Wr.norm() + 1e-300);
 }
 
 // a stylus standing above a surface VM's plane, more or less upright, the
@@ -120,7 +125,7 @@ VectorXd plain_gauss_newton_step(const VirtualMechanism& vm, const RmPose& rm,
                                  const Vec6& w, const VmAngles& theta) {
   VmJacobian J;
   vm.jacobian(theta, &J);
-  const MatrixXd B = w.cwiseSqrt().asDiagonal() * X(J);
+  const MatrixXd B = w.cwiseSqrt().asDiagonal() * dynamic_copy(J);
   const VectorXd b =
       w.cwiseSqrt().asDiagonal() * VectorXd(placement_residual(vm, rm, theta));
   Eigen::JacobiSVD<MatrixXd> svd(B, Eigen::ComputeThinU | Eigen::ComputeThinV);
@@ -394,7 +399,7 @@ TEST(PlaceGaussNewton, LockedJointsStayAndSurfaceStickingIsNearest) {
 // would still go from theta; zero at a stationary point
 double gradient_over_curvature(const VirtualMechanism& vm, const RmPose& rm,
                                const Vec6& w, const VmAngles& theta) {
-  const MatrixXd J = X([&] {
+  const MatrixXd J = dynamic_copy([&] {
     VmJacobian Jv;
     vm.jacobian(theta, &Jv);
     return Jv;

@@ -20,6 +20,11 @@
 
 #include "controller/omni_kinematics.h"  // wrap_angle
 #include "controller/virtual_mechanism.h"
+#include "controller/vm_circle.h"
+#include "controller/vm_line.h"
+#include "controller/vm_registry.h"
+#include "controller/vm_sphere.h"
+#include "controller/vm_surface.h"
 #include "tests/support/random_vm.h"
 #include "tests/support/constants.h"
 

@@ -7,6 +7,11 @@
 // Every VM is checked with the default mount and with a pivot away from the
 // origin in a turned frame, at a long (50) and a short (0.05) link.
 #include "controller/virtual_mechanism.h"
+#include "controller/vm_circle.h"
+#include "controller/vm_line.h"
+#include "controller/vm_registry.h"
+#include "controller/vm_sphere.h"
+#include "controller/vm_surface.h"
 #include "tests/support/random_vm.h"
 #include "tests/support/vm_cases.h"
 
@@ -33,7 +38,6 @@ using vmh::testing::kPi;
 using testing::all_cases;
 using testing::Case;
 using testing::cases;
-using testing::make_vm;
 using testing::turned_mount;
 using testing::random_theta;
 using testing::random_unit;
@@ -48,7 +52,9 @@ Vec3 vee(const Mat3& S) {
 
 // the column of the handle frame that the header documents as the link axis
 Vec3 documented_axis_column(const VirtualMechanism& vm, const Mat3& R) {
-  return vm.kind() == VmKind::kCircle ? Vec3(R.col(0)) : Vec3(R.col(2));
+  const bool planar =
+      vm.kind() == VmKind::kCircle || vm.kind() == VmKind::kLine;
+  return planar ? Vec3(R.col(0)) : Vec3(R.col(2));
 }
 
 // where the link starts: the pivot, or the surface's contact point
@@ -125,6 +131,15 @@ TEST(VmPose, FrameAxisAndLinkLength) {
       EXPECT_NEAR(pose.axis.norm(), 1.0, 1e-12) << c.name;
       EXPECT_LE((pose.axis - documented_axis_column(vm, pose.R)).norm(), 1e-12)
           << c.name;
+      if (vm.kind() == VmKind::kLine) {
+        // on the line through the origin along the pivot frame's y, the
+        // handle frame the pivot frame (the link never turns)
+        const Vec3 t = vm.mount().R.col(1), d = pose.p - vm.mount().origin;
+        EXPECT_LE((d - d.dot(t) * t).norm(), 1e-12 * (1 + L)) << c.name;
+        EXPECT_NEAR(d.dot(t), theta[0], 1e-12 * (1 + L)) << c.name;
+        EXPECT_LE((pose.R - vm.mount().R).norm(), 0.0) << c.name;
+        continue;
+      }
       const Vec3 base = link_base(vm, theta);
       EXPECT_NEAR((pose.p - base).norm(), L, 1e-12 * (1 + L)) << c.name;
       EXPECT_LE((pose.p - base - L * pose.axis).norm(), 1e-12 * (1 + L))
@@ -423,6 +438,14 @@ TEST(VmNearest, UndefinedAtThePivot) {
     const VmAngles start = random_theta(vm, &rng);
     VmAngles theta = start;
     const RmPose rm{link_base(vm, start), random_unit(&rng)};
+    if (vm.kind() == VmKind::kLine) {
+      // a line has no pivot: every point has a foot on it
+      EXPECT_TRUE(vm.nearest(rm, &theta)) << c.name;
+      EXPECT_LE((vm.position(theta) - vm.nearest_on_path(rm.p)).norm(),
+                1e-12 * (1 + vm.length()))
+          << c.name;
+      continue;
+    }
     EXPECT_FALSE(vm.nearest(rm, &theta)) << c.name;
     EXPECT_TRUE(theta == start) << c.name;
     if (vm.kind() == VmKind::kCircle) {
@@ -531,6 +554,13 @@ TEST(VmAligned, LinkAxisIsTheStylusAxis) {
       VmAngles theta = start;
       ASSERT_TRUE(vm.aligned(rm, &theta)) << c.name;
       const VmPose pose = vm.pose(theta);
+      if (vm.kind() == VmKind::kLine) {
+        // no s turns the link: theta_R is the foot of the perpendicular
+        EXPECT_LE((pose.p - vm.nearest_on_path(rm.p)).norm(), 1e-12 * (1 + L))
+            << c.name;
+        EXPECT_LE((pose.axis - vm.mount().R.col(0)).norm(), 0.0) << c.name;
+        continue;
+      }
       if (vm.kind() == VmKind::kCircle) {
         const Vec3 proj = (rm.axis - rm.axis.dot(n) * n).normalized();
         EXPECT_LE((pose.axis - proj).norm(), 1e-12) << c.name;
@@ -649,7 +679,8 @@ TEST(VmNormalize, MinusPiBecomesPi) {
 // -------------------------------------------------------- orientation errors
 
 TEST(VmKindName, RoundTripAndRejection) {
-  for (VmKind k : {VmKind::kCircle, VmKind::kSphere, VmKind::kSurface}) {
+  for (const VmDescriptor& d : vm_registry()) {
+    const VmKind k = d.kind;
     VmKind parsed = k == VmKind::kCircle ? VmKind::kSphere : VmKind::kCircle;
     ASSERT_TRUE(parse_vm_kind(vm_kind_name(k), &parsed));
     EXPECT_EQ(parsed, k);
@@ -657,6 +688,8 @@ TEST(VmKindName, RoundTripAndRejection) {
   EXPECT_STREQ(vm_kind_name(VmKind::kCircle), "circle");
   EXPECT_STREQ(vm_kind_name(VmKind::kSphere), "sphere");
   EXPECT_STREQ(vm_kind_name(VmKind::kSurface), "surface");
+  EXPECT_STREQ(vm_kind_name(VmKind::kLine), "line");
+  EXPECT_EQ(vm_kind_names(), "circle, sphere, surface, line");
   VmKind untouched = VmKind::kSurface;
   for (const char* bad : {"cube", "", "circles", "Sphere", "surface "}) {
     EXPECT_FALSE(parse_vm_kind(bad, &untouched)) << bad;
@@ -668,6 +701,7 @@ TEST(VmKindName, KindAndDof) {
   EXPECT_EQ(CircleVm(VmMount{}, 1.0).dof(), 1);
   EXPECT_EQ(SphereVm(VmMount{}, 1.0).dof(), 3);
   EXPECT_EQ(SurfaceVm(VmMount{}, 1.0).dof(), 5);
+  EXPECT_EQ(LineVm(VmMount{}, 1.0).dof(), 1);
   for (const Case& c : all_cases()) {
     EXPECT_EQ(c.vm->zero_angles().size(), c.vm->dof());
     EXPECT_TRUE(c.vm->zero_angles().isZero(0.0));
@@ -677,7 +711,8 @@ TEST(VmKindName, KindAndDof) {
 TEST(VmConstruction, RejectsBadParameters) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
-  for (VmKind kind : {VmKind::kCircle, VmKind::kSphere, VmKind::kSurface}) {
+  for (const VmDescriptor& d : vm_registry()) {
+    const VmKind kind = d.kind;
     for (double L : {0.0, -1.0, nan, inf}) {
       EXPECT_THROW(make_vm(kind, VmMount{}, L), std::invalid_argument)
           << vm_kind_name(kind) << " L " << L;

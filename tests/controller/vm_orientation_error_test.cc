@@ -10,6 +10,11 @@
 #include <random>
 
 #include "controller/virtual_mechanism.h"
+#include "controller/vm_circle.h"
+#include "controller/vm_line.h"
+#include "controller/vm_registry.h"
+#include "controller/vm_sphere.h"
+#include "controller/vm_surface.h"
 #include "tests/support/random_vm.h"
 #include "tests/support/vm_cases.h"
 #include "tests/support/constants.h"
@@ -220,7 +225,9 @@ TEST(VmGeometricError, OrientationErrorJacobianIsItsDerivative) {
     const VmPose pose = vm.pose(random_theta(vm, &rng));
     const Mat3 M0 = vm.orientation_error_jacobian(pose, RmPose{Vec3(), pose.axis});
     const Vec3 n = vm.mount().R.col(2);
-    const Mat3 expected = vm.kind() == VmKind::kCircle
+    const bool planar =
+        vm.kind() == VmKind::kCircle || vm.kind() == VmKind::kLine;
+    const Mat3 expected = planar
                               ? Mat3(n * n.transpose())
                               : Mat3(Mat3::Identity() - pose.axis * pose.axis.transpose());
     EXPECT_LE((M0 - expected).norm(), 1e-12) << c.name;

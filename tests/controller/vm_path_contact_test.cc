@@ -28,7 +28,7 @@ using testing::uniform;
 
 // The closed-form path (distance_to_path, nearest_on_path) against the
 // handle positions pose(theta) itself reaches: the circle and sphere sampled
-// densely; for the surface the probe upright (beta = alpha = pi/2, or the
+// densely, the line over 8L about its origin; for the surface the probe upright (beta = alpha = pi/2, or the
 // probe turned over) over every contact point, so its path is the two
 // planes L from the plane. The nearest point lies on the path (distance 0),
 // is no farther than any sample, and the distance is |p - nearest|.
@@ -48,6 +48,12 @@ TEST(VmPath, ClosedFormAgreesWithSampledPoses) {
     } else if (vm.kind() == VmKind::kSphere) {
       for (int i = 0; i < 40000; ++i) {
         path.push_back(vm.pose(random_theta(vm, &rng)).p);
+      }
+    } else if (vm.kind() == VmKind::kLine) {
+      // the points tried lie within 3L of the origin
+      for (int i = 0; i <= 20000; ++i) {
+        theta[0] = -4 * L + 8 * L * i / 20000.0;
+        path.push_back(vm.pose(theta).p);
       }
     }
     for (int k = 0; k < 20; ++k) {
@@ -73,8 +79,13 @@ TEST(VmPath, ClosedFormAgreesWithSampledPoses) {
       EXPECT_GE(best, d - 1e-12 * (1 + L)) << c.name;
       EXPECT_LE(best, d + 2e-2 * L) << c.name;
     }
+    // the line passes through its origin
+    if (vm.kind() == VmKind::kLine) {
+      EXPECT_LE((vm.nearest_on_path(o) - o).norm(), 1e-12 * (1 + L));
+      EXPECT_NEAR(vm.distance_to_path(o), 0.0, 1e-12 * (1 + L));
+    }
     // at the pivot every point of the path is nearest: the pivot is kept
-    if (vm.kind() != VmKind::kSurface) {
+    if (vm.kind() == VmKind::kCircle || vm.kind() == VmKind::kSphere) {
       EXPECT_EQ(vm.nearest_on_path(o), o) << c.name;
       EXPECT_NEAR(vm.distance_to_path(o), L, 1e-12 * (1 + L)) << c.name;
     }

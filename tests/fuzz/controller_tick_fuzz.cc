@@ -76,7 +76,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data,
   FuzzedDataProvider in(data, size);
 
   ControllerParams p;
-  p.vm.kind = static_cast<VmKind>(in.ConsumeIntegralInRange<int>(0, 2));
+  // any registered mechanism
+  const int kinds = static_cast<int>(vm_registry().size());
+  p.vm.kind = vm_registry()[static_cast<std::size_t>(
+                                in.ConsumeIntegralInRange<int>(0, kinds - 1))]
+                  .kind;
   for (int i = 0; i < 3; ++i) p.vm.pivot_mm[i] = any_double(in, -200, 200);
   if (in.ConsumeBool()) {
     // a rotated pivot frame (a proper rotation from an angle-axis)

@@ -24,7 +24,7 @@ inline Vec3 random_unit(std::mt19937* rng) {
 }
 
 // random VM angles away from the sphere's and the surface's poles; the
-// surface's contact within 2L of its origin
+// surface's contact and the line's handle within 2L of the origin
 inline VmAngles random_theta(const VirtualMechanism& vm, std::mt19937* rng) {
   constexpr double kPi = 3.14159265358979323846;
   VmAngles t(vm.dof());
@@ -41,6 +41,9 @@ inline VmAngles random_theta(const VirtualMechanism& vm, std::mt19937* rng) {
       t << uniform(rng, -2 * L, 2 * L), uniform(rng, -2 * L, 2 * L),
           uniform(rng, -kPi, kPi), uniform(rng, 0.2, kPi - 0.2),
           uniform(rng, -kPi, kPi);
+      break;
+    case VmKind::kLine:
+      t << uniform(rng, -2 * L, 2 * L);
       break;
   }
   return t;

@@ -1,4 +1,5 @@
-// The virtual mechanisms the controller tests run over: every kind, with the
+// The virtual mechanisms the controller tests run over: every registered
+// kind (all_cases), or those named, each with the
 // default mount and a pivot away from the origin in a turned frame, at a
 // long (50) and a short (0.05) link.
 #ifndef VMHAPTICS_TESTS_SUPPORT_VM_CASES_H_
@@ -10,6 +11,11 @@
 #include <vector>
 
 #include "controller/virtual_mechanism.h"
+#include "controller/vm_circle.h"
+#include "controller/vm_line.h"
+#include "controller/vm_registry.h"
+#include "controller/vm_sphere.h"
+#include "controller/vm_surface.h"
 
 namespace vmh::testing {
 
@@ -26,19 +32,6 @@ struct Case {
   std::string name;
 };
 
-inline std::unique_ptr<VirtualMechanism> make_vm(VmKind kind, const VmMount& mount,
-                                          double L) {
-  switch (kind) {
-    case VmKind::kCircle:
-      return std::make_unique<CircleVm>(mount, L);
-    case VmKind::kSphere:
-      return std::make_unique<SphereVm>(mount, L);
-    case VmKind::kSurface:
-      return std::make_unique<SurfaceVm>(mount, L);
-  }
-  return nullptr;
-}
-
 // kinds x {default mount, turned mount} x {50, 0.05}
 inline std::vector<Case> cases(std::vector<VmKind> kinds) {
   std::vector<Case> out;
@@ -46,7 +39,7 @@ inline std::vector<Case> cases(std::vector<VmKind> kinds) {
     for (int turned = 0; turned < 2; ++turned) {
       for (double L : {50.0, 0.05}) {
         const VmMount mount = turned ? turned_mount() : VmMount{};
-        out.push_back({make_vm(kind, mount, L),
+        out.push_back({vmh::make_vm(kind, mount, L),
                        std::string(vm_kind_name(kind)) +
                            (turned ? " turned" : " default") +
                            " L=" + std::to_string(L)});
@@ -56,8 +49,11 @@ inline std::vector<Case> cases(std::vector<VmKind> kinds) {
   return out;
 }
 
+// every registered kind (controller/vm_registry.h)
 inline std::vector<Case> all_cases() {
-  return cases({VmKind::kCircle, VmKind::kSphere, VmKind::kSurface});
+  std::vector<VmKind> kinds;
+  for (const VmDescriptor& d : vm_registry()) kinds.push_back(d.kind);
+  return cases(kinds);
 }
 
 
