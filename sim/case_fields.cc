@@ -7,6 +7,7 @@
 #include <string>
 
 #include "controller/virtual_mechanism.h"
+#include "controller/vm_registry.h"
 #include "sim/case_params_detail.h"
 
 namespace vmh::sim {
@@ -88,34 +89,60 @@ Row text(const char* group, const char* name, const char* def,
 
 }  // namespace
 
+namespace {
+
+// the registered mechanisms' names ("circle, sphere, surface, line") and
+// one line on each, for vm_kind (controller/vm_registry.h)
+const std::string& vm_kind_words() {
+  static const std::string words = vm_kind_names();
+  return words;
+}
+
+const std::string& vm_kind_doc() {
+  static const std::string doc = [] {
+    std::string d = "virtual mechanism (controller/vm_registry.h):";
+    const auto& all = vm_registry();
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      d += std::string(i == 0 ? " " : "; ") + all[i].name + ", " +
+           all[i].summary;
+    }
+    return d;
+  }();
+  return doc;
+}
+
+}  // namespace
+
 const std::vector<ParamSpec>& case_fields() {
   static const std::vector<ParamSpec> fields = {
       // ---- the case ----
       numeric("case", "thesis_case", 1, "0", "-",
-              "which thesis case's claims to check, 1..6 (0: none)",
+              "which case's claims to check: 1..6 the thesis's, 7 the line "
+              "slider's (this project's, the circle's limit; "
+              "docs/testbed.md); 0: none",
               [](CaseParams* p, const ParamValue& v) {
                 p->thesis_case = whole(v);
               })
-          .whole_in(0, 6),
+          .whole_in(0, 7),
 
       // ---- the controller (scenes and `ctl` alike) ----
-      text("controller", "vm_kind", nullptr, "circle, sphere, surface",
-           "virtual mechanism: circle (eq. 3.25), sphere (eq. 3.29) or "
-           "surface",
+      text("controller", "vm_kind", nullptr, vm_kind_words().c_str(),
+           vm_kind_doc().c_str(),
            [](CaseParams* p, const ParamValue& v) {
              parse_vm_kind(v.text.c_str(), &p->controller.vm_kind);
            })
           .ctl("--vm")
           .ctl_default_is("circle"),
       numeric("controller", "vm_pivot_mm", 3, "0 0 0", "mm",
-              "VM pivot (circle, sphere) or a point of the plane (surface), "
-              "device frame (Appendix D: the origin)",
+              "VM pivot (circle, sphere), a point of the plane (surface) or "
+              "of the line (line), device frame (Appendix D: the origin)",
               [](CaseParams* p, const ParamValue& v) {
                 p->controller.vm_pivot_mm = vec3(v);
               })
           .ctl("--pivot-mm"),
       numeric("controller", "vm_length_mm", 1, "50", "mm",
-              "VM link length L (Lv = 50)",
+              "VM link length L (Lv = 50); the line slider does not use it in "
+              "its law: its drawn link and the scripts' scale",
               [](CaseParams* p, const ParamValue& v) {
                 p->controller.vm_length_mm = item(v);
               })

@@ -23,10 +23,9 @@ double smoothstep(double s) {
 }  // namespace
 
 HandScript::HandScript(const CaseParams& c, const VmParams& vm)
-    : script_(c.script.kind), kind_(vm.kind) {
+    : script_(c.script.kind) {
   pivot_ = vm.pivot_mm;
-  n_ = vm.R_pivot.col(2);
-  n_unit_ = n_.normalized();
+  n_unit_ = vm.R_pivot.col(2).normalized();
   length_mm_ = vm.length_mm;
   off_mm_ = c.script.off_mm;
   misalign_rad_ = c.script.misalign_rad;
@@ -35,33 +34,27 @@ HandScript::HandScript(const CaseParams& c, const VmParams& vm)
   const Vec3 dir = c.script.dir.normalized();
   const double D = c.sim.duration_s;
 
-  // the start pose: on the path, the stylus along `dir` (for the circle only
-  // its projection on the plane counts, so it is aligned there too)
-  if (kind_ == VmKind::kCircle) {
-    const Vec3 in_plane = dir - dir.dot(n_) * n_;
-    if (in_plane.norm() < 1e-6) {
-      throw SimError(c.scene_path() +
-                     ": field 'script_dir' is along the circle's normal; the "
-                     "start pose on the path is undefined");
-    }
-    r0_ = in_plane.normalized();
-  } else if (kind_ == VmKind::kSphere) {
-    r0_ = dir;
-  } else {
-    // the surface: "outward" is the plane's normal, the start pose L above
-    // the plane's reference point with the stylus along the normal
-    r0_ = n_;
+  // the start pose on the path toward `dir`, as the mechanism gives it
+  // (controller/virtual_mechanism.h, path_start): for the circle and the
+  // line only dir's part in their plane counts, the surface stands its
+  // probe upright over its origin
+  VmMount mount;
+  mount.origin = pivot_;
+  mount.R = vm.R_pivot;
+  vm_ = make_vm(vm.kind, mount, length_mm_);
+  if (!vm_->path_start(dir, &start_)) {
+    throw SimError(c.scene_path() + ": field 'script_dir' is along the " +
+                   vm_kind_name(vm.kind) +
+                   "'s normal; the start pose on the path is undefined");
   }
-  axis0_ = kind_ == VmKind::kSurface ? n_ : dir;
+  r0_ = start_.outward;
+  t0_ = start_.tangent;
+  p0_ = start_.p;
+  axis0_ = start_.axis;
   // an explicit stylus axis, for poses the direction alone cannot give (the
   // stylus along the forearm, or turned away from the link)
   const Vec3 axis_set = c.script.axis;
   if (axis_set.norm() > 1e-9) axis0_ = axis_set.normalized();
-  p0_ = pivot_ + length_mm_ * r0_;
-  // the tangent of the sweep: about the normal for circle and sphere
-  Vec3 t = n_.cross(r0_);
-  if (t.norm() < 1e-6) t = r0_.unitOrthogonal();
-  t0_ = t.normalized();
 
   if (script_ == ScriptKind::kHold) {
     segments_ = {{"hold", 0.0, D, true}};
@@ -144,9 +137,11 @@ ScriptPose HandScript::raw(int segment, double t_s) const {
   pose.p_mm = p0_;
   pose.axis = axis0_;
   const Shape shape = shapes_[static_cast<std::size_t>(segment)];
-  // misalignment turns the stylus toward the tangent: for the circle about
-  // its normal (theta_R moves along the path); for the sphere the second
-  // on-path hold tilts it about the tangent instead (the polar angle)
+  // misalignment turns the stylus toward the tangent: for the circle and
+  // the line about their normal (the circle's theta_R moves along the
+  // path); the second on-path hold tilts it about the mechanism's tilt_b
+  // (the planar ones: the other way about the normal; the sphere: about
+  // the tangent, its polar angle)
   const Vec3 m = r0_.cross(t0_);
   // the pivot and spin scripts: two full swings over the segment, starting
   // where the previous segment ended
@@ -182,9 +177,7 @@ ScriptPose HandScript::raw(int segment, double t_s) const {
       pose.axis = rotate(axis0_, m, misalign_rad_);
       break;
     case Shape::kOnMisalignedB:
-      pose.axis = kind_ == VmKind::kSphere
-                      ? rotate(axis0_, t0_, misalign_rad_)
-                      : rotate(axis0_, m, -misalign_rad_);
+      pose.axis = rotate(axis0_, start_.tilt_b, misalign_rad_);
       break;
     case Shape::kSweep: {
       const ScriptSegment& s = segments_[static_cast<std::size_t>(segment)];
@@ -194,10 +187,10 @@ ScriptPose HandScript::raw(int segment, double t_s) const {
       // start pose
       const double phi = sweep_rad_ * std::sin(kTwoPi * tau / T);
       const double across = sweep_mm_ * std::sin(4.0 * kTwoPi * tau / T);
-      // one rotation for both: what rotate() would build twice
-      const Mat3 turn = Eigen::AngleAxisd(phi, n_unit_).toRotationMatrix();
-      const Vec3 r = turn * r0_;
-      pose.p_mm = pivot_ + (length_mm_ + across) * r;
+      // along the path as the mechanism moves (turning about its normal,
+      // or sliding), the stylus turned with it
+      Mat3 turn;
+      vm_->along_path(start_, phi, across, &pose.p_mm, &turn);
       pose.axis = turn * axis0_;
       break;
     }

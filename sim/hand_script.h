@@ -14,6 +14,7 @@
 #ifndef VMHAPTICS_SIM_HAND_SCRIPT_H_
 #define VMHAPTICS_SIM_HAND_SCRIPT_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -74,9 +75,11 @@ class HandScript {
 
   ScriptKind script_;
   std::vector<ScriptSegment> segments_;
-  VmKind kind_;
-  Vec3 pivot_, n_, r0_, t0_, p0_, axis0_;
-  Vec3 n_unit_;  // n_.normalized(), for the moving segments' rotations
+  // the mechanism in mm, for its path_start and along_path hooks
+  std::shared_ptr<const VirtualMechanism> vm_;
+  PathStart start_;
+  Vec3 pivot_, r0_, t0_, p0_, axis0_;
+  Vec3 n_unit_;  // the pivot frame's z, for the spin's rotation
   double length_mm_, off_mm_, misalign_rad_, sweep_mm_, sweep_rad_;
   double blend_s_ = 0.3;
   // per segment: its shape; whether its pose moves with time; its pose

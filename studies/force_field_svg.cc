@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "output/svg_text.h"
+#include "studies/path_svg.h"
 
 namespace vmh::studies {
 namespace {
@@ -38,7 +39,7 @@ std::string field_num(double v) {
   return s == "-0" ? "0" : s;
 }
 
-// one panel: the path's outline (the circle, or the sphere's outline in
+// one panel: the path (the circle, the line, or the sphere's outline in
 // this projection), the trajectory and the arrows
 std::string panel(const std::vector<ForceSample>& s,
                   const std::vector<std::size_t>& picked,
@@ -99,14 +100,25 @@ std::string panel(const std::vector<ForceSample>& s,
       }
     }
   }
-  // the path: a circle of radius L about the pivot (the sphere's outline in
-  // a projection along a device axis)
+  // the path as the mechanism draws it (studies/path_svg.h)
   if (path.length_mm > 0.0) {
-    g += "<circle" + attr("id", "ff-path-" + v.tag) +
-         attr("cx", px(X(path.pivot_mm[v.across]))) +
-         attr("cy", px(Y(path.pivot_mm[v.up]))) +
-         attr("r", px(path.length_mm * scale)) +
-         " fill=\"none\" stroke=\"#1f77b4\" stroke-width=\"1.5\"/>\n";
+    PathView pv;
+    pv.a = Vec3::Unit(v.across);
+    pv.b = Vec3::Unit(v.up);
+    pv.X = X;
+    pv.Y = Y;
+    pv.px_per_mm = scale;
+    pv.lo[0] = c0 - span / 2;
+    pv.lo[1] = c1 - span / 2;
+    pv.hi[0] = c0 + span / 2;
+    pv.hi[1] = c1 + span / 2;
+    g += path_elements(
+        vm_path_mm(path.vm_kind,
+                   Vec3(path.pivot_mm[0], path.pivot_mm[1], path.pivot_mm[2]),
+                   path.length_mm)
+            .primitives,
+        pv, "ff-path-" + v.tag,
+        attr("stroke", "#1f77b4") + attr("stroke-width", "1.5"));
   }
   // the trajectory, thinned to about 1500 points
   std::string pts;
@@ -149,7 +161,13 @@ std::string panel(const std::vector<ForceSample>& s,
 
 std::string force_field_svg(const std::vector<ForceSample>& samples,
                             const ForceFieldPath& path, std::size_t arrows) {
-  const bool plane = path.vm_kind == "circle";
+  // a planar path (the circle, the line): one view, its plane
+  const bool plane =
+      path.length_mm > 0.0 &&
+      vm_path_mm(path.vm_kind,
+                 Vec3(path.pivot_mm[0], path.pivot_mm[1], path.pivot_mm[2]),
+                 path.length_mm)
+          .planar;
   std::vector<View> views;
   if (plane) {
     views = {{"xy", 0, 1}};
@@ -214,7 +232,7 @@ std::string force_field_svg(const std::vector<ForceSample>& samples,
          escape("device frame, mm; arrow 1 N = " + field_num(mm_per_N) +
                 " mm; blue: the VM's path" +
                 (plane ? std::string(" (its plane)")
-                       : std::string(" (the sphere's outline)")) +
+                       : " (the " + path.vm_kind + "'s outline)") +
                 "; grey: RM wrist centre; largest |F| " + field_num(max_F) + " N") +
          "</text>\n";
   for (std::size_t k = 0; k < views.size(); ++k) {

@@ -34,9 +34,9 @@ struct ForceSample {
 
 // the VM's path as the case's parameters give it
 struct ForceFieldPath {
-  std::string vm_kind;  // "circle", "sphere" or "surface"
+  std::string vm_kind;  // a registered name: "circle", "sphere", ...
   std::array<double, 3> pivot_mm{};
-  double length_mm = 0.0;  // the circle's or the sphere's radius L
+  double length_mm = 0.0;  // the VM's length L
 };
 
 // arrows drawn by default

@@ -1,14 +1,15 @@
 // What the virtual-mechanism law gives at a pose, computed by a route
 // independent of the controller: from the ground-truth wrist centre and
-// stylus axis (not the quantised readings), the closed-form placement of
-// the circle and the sphere (§3.3.1, §3.4.1), and the VM Jacobian built
-// without its joint angles.
+// stylus axis (not the quantised readings), the mechanism's closed-form
+// placement and its VM Jacobian built without its joint angles (its
+// prediction hook, controller/vm_registry.h: the circle and the sphere,
+// §3.3.1, §3.4.1, and the line).
 //
 // The circle's and the sphere's VM are a link of length L turning about
 // the pivot, so whatever their angles, J_V's columns span the rigid
 // rotations about the pivot: [w x L u; w] for w along the circle's normal
-// n (one column) or any w (the sphere, three columns), u the link axis.
-// Eq. 3.11 projects g = (K_p e_p, K_o e_o) with the held hand's e_dot = 0,
+// n (one column) or any w (the sphere, three columns), u the link axis;
+// the line's one column is [t; 0]. Eq. 3.11 projects g = (K_p e_p, K_o e_o) with the held hand's e_dot = 0,
 // f = g - W J (J^T W J)^-1 J^T g with W the projection weights, in the
 // controller's length unit (docs/controller.md); the force on the wrist is
 // f's first three rows (eq. 3.12 with J_v).
@@ -39,7 +40,8 @@ struct LawPrediction {
 
 // p_mm and axis: wrist centre (mm) and stylus axis (unit), device frame;
 // q_dh: the joint angles (DH, rad) of the same pose, for the torque limits.
-// Circle and sphere only; a surface VM gives available = false.
+// Where the mechanism has a hook (the surface has none), else available =
+// false with the reason.
 LawPrediction predict_static_law(const ControllerParams& p, const Vec3& p_mm,
                                  const Vec3& axis, const Joints& q_dh);
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "output/svg_text.h"
+#include "studies/path_svg.h"
 
 namespace vmh::studies {
 // the testbed's types (sim/) by their own names in this file
@@ -106,6 +107,8 @@ class Svg {
     close("clipPath");
   }
 
+  // elements made elsewhere (studies/path_svg.h)
+  void raw(const std::string& elements) { s_ += elements; }
   std::string finish() const { return s_ + "</svg>\n"; }
 
  private:
@@ -275,6 +278,12 @@ struct ViewLayout {
   static constexpr double kLegendW = 300.0;
 };
 
+// the VM's path as its drawing hook gives it, device frame, mm
+VmPath path_of(const VmParams& vm) {
+  return vm_path_mm(vm_kind_name(vm.kind), vm.pivot_mm, vm.length_mm,
+                    vm.R_pivot);
+}
+
 void view_panel(Svg& svg, double ox, double oy, const std::string& name,
                 const Snapshot& snap, const Projection& proj,
                 const std::vector<TickRecord>& rows, const VmParams& vm) {
@@ -283,13 +292,8 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
   auto u = [&](const Vec3& p) { return proj.a.dot(p); };
   auto v = [&](const Vec3& p) { return proj.b.dot(p); };
   const double L = vm.length_mm;
-  const bool outline = vm.kind != VmKind::kSurface;
-  const Vec3 n = vm.R_pivot.col(2);
-  // the surface's path (the handle L above the plane) is a line in views
-  // that hold the normal, and fills the others
-  const bool surface_line =
-      vm.kind == VmKind::kSurface &&
-      (n - proj.a.dot(n) * proj.a - proj.b.dot(n) * proj.b).norm() < 1e-6;
+  // the path as the mechanism draws it (its drawing hook), mm
+  const std::vector<PathPrimitive> path = path_of(vm).primitives;
   const std::vector<std::size_t> idx = decimated(rows.size());
 
   // what must be in view
@@ -299,14 +303,26 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
     bv.add(v(p));
   };
   add(vm.pivot_mm);
-  if (outline) {
-    bu.add(u(vm.pivot_mm) - L);
-    bu.add(u(vm.pivot_mm) + L);
-    bv.add(v(vm.pivot_mm) - L);
-    bv.add(v(vm.pivot_mm) + L);
-  } else {
-    add(vm.pivot_mm + L * n);
-    add(vm.pivot_mm - L * n);
+  for (const PathPrimitive& prim : path) {
+    switch (prim.type) {
+      case PathPrimitive::Type::kCircle:
+      case PathPrimitive::Type::kSphere:
+        bu.add(u(prim.centre) - prim.radius);
+        bu.add(u(prim.centre) + prim.radius);
+        bv.add(v(prim.centre) - prim.radius);
+        bv.add(v(prim.centre) + prim.radius);
+        break;
+      case PathPrimitive::Type::kLine:
+        add(prim.centre + L * prim.u);
+        add(prim.centre - L * prim.u);
+        break;
+      case PathPrimitive::Type::kPlane: {
+        const Vec3 n = prim.u.cross(prim.v);
+        add(prim.centre + prim.radius * n);
+        add(prim.centre - prim.radius * n);
+        break;
+      }
+    }
   }
   for (std::size_t i : idx) add(rows[i].out.p_rm_mm);
   const TickRecord* r = snap.row;
@@ -347,7 +363,6 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
   f.ylo = static_cast<double>(v0) * step;
   f.yhi = static_cast<double>(v1) * step;
   f.xstep = f.ystep = step;
-  const double mm = f.width / (f.xhi - f.xlo);  // px per mm, both axes
 
   svg.open("g", attr("class", "panel") + attr("id", "panel-" + tag));
   std::string title = name + ": " + snap.what;
@@ -366,21 +381,18 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
   svg.clip_rect("clip-" + tag, f.left, f.top, f.width, f.height);
   svg.open("g", attr("clip-path", "url(#clip-" + tag + ")"));
   const double pu = u(vm.pivot_mm), pv = v(vm.pivot_mm);
-  if (outline) {
-    svg.circle(f.X(pu), f.Y(pv), L * mm,
-               attr("id", "path-" + tag) + attr("fill", "none") +
-                   attr("stroke", "#555") + attr("stroke-width", "1.2"));
-  } else if (surface_line) {
-    // both sides of the plane, as far as the frame
-    const double du = -v(n), dv = u(n);
-    const double far = 10.0 * (f.xhi - f.xlo);
-    for (double side : {-1.0, 1.0}) {
-      const Vec3 c = vm.pivot_mm + side * L * n;
-      svg.line(f.X(u(c) - far * du), f.Y(v(c) - far * dv),
-               f.X(u(c) + far * du), f.Y(v(c) + far * dv),
-               attr("stroke", "#555") + attr("stroke-dasharray", "6 3"));
-    }
-  }
+  PathView view;
+  view.a = proj.a;
+  view.b = proj.b;
+  view.X = [&f](double x) { return f.X(x); };
+  view.Y = [&f](double y) { return f.Y(y); };
+  view.px_per_mm = f.width / (f.xhi - f.xlo);
+  view.lo[0] = f.xlo;
+  view.lo[1] = f.ylo;
+  view.hi[0] = f.xhi;
+  view.hi[1] = f.yhi;
+  svg.raw(path_elements(path, view, "path-" + tag,
+                        attr("stroke", "#555") + attr("stroke-width", "1.2")));
   std::vector<Pt> trail;
   trail.reserve(idx.size());
   for (std::size_t i : idx) {
@@ -423,9 +435,12 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
 }
 
 void view_legend(Svg& svg, double x, double y, const VmParams& vm) {
-  const std::string kind = vm.kind == VmKind::kCircle   ? "circle"
-                           : vm.kind == VmKind::kSphere ? "sphere (outline)"
-                                                        : "surface (plane + L)";
+  const VmPath vm_path = path_of(vm);
+  const std::string kind = vm_path.label;
+  bool plane = false;
+  for (const PathPrimitive& prim : vm_path.primitives) {
+    plane = plane || prim.type == PathPrimitive::Type::kPlane;
+  }
   svg.open("g", attr("id", "legend"));
   svg.text(x, y, "Legend", attr("font-weight", "bold"));
   double yy = y + 20.0;
@@ -443,7 +458,7 @@ void view_legend(Svg& svg, double x, double y, const VmParams& vm) {
     };
   };
   item("VM path: " + kind + ", L = " + plot_num(vm.length_mm) + " mm",
-       stroke("#555", "1.2", vm.kind == VmKind::kSurface ? "6 3" : ""));
+       stroke("#555", "1.2", plane ? "6 3" : ""));
   item("RM wrist centre p over the run", stroke("#a8a8a8", "0.8", ""));
   item("p at the snapshot", [&svg](double x0, double y0) {
     svg.circle(x0 + 13.0, y0, 3.0, attr("fill", "#000"));
@@ -502,10 +517,11 @@ std::string views_svg(const std::vector<TickRecord>& rows,
   for (Snapshot& s : snaps) find_snapshot(rows, the_case, &s);
 
   std::vector<Projection> projs;
-  if (vm.kind == VmKind::kCircle) {
+  if (path_of(vm).planar) {
+    // a planar path: one view, in its plane
     const bool device = vm.R_pivot.isApprox(Mat3::Identity(), 1e-12);
-    projs.push_back({"", device ? "circle plane (device x-y)"
-                                : "circle plane (pivot frame x-y)",
+    const std::string plane = std::string(vm_kind_name(vm.kind)) + " plane";
+    projs.push_back({"", plane + (device ? " (device x-y)" : " (pivot frame x-y)"),
                      vm.R_pivot.col(0), vm.R_pivot.col(1),
                      device ? "x_mm" : "x_pivot_mm",
                      device ? "y_mm" : "y_pivot_mm"});
@@ -524,10 +540,12 @@ std::string views_svg(const std::vector<TickRecord>& rows,
   const double width = cols * ViewLayout::kCellW + ViewLayout::kLegendW;
   const double height =
       ViewLayout::kHeader + nrows * ViewLayout::kCellH + 10.0;
+  const std::string thesis_figures = vm_descriptor(vm.kind).thesis_figures;
+  const std::string figures =
+      thesis_figures.empty() ? "" : " (cf. thesis Figs " + thesis_figures + ")";
   Svg svg(width, height);
   svg.text(12.0, 20.0,
-           name + ": the RM and the VM, off and on the path (cf. thesis Figs " +
-               (vm.kind == VmKind::kCircle ? "4.1-4.2)" : "4.13-4.18)"),
+           name + ": the RM and the VM, off and on the path" + figures,
            attr("font-size", "14") + attr("font-weight", "bold"));
   for (std::size_t s = 0; s < snaps.size(); ++s) {
     for (std::size_t k = 0; k < projs.size(); ++k) {

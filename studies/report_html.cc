@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "controller/vm_registry.h"
 #include "output/output_file.h"
 
 #include "output/svg_text.h"
@@ -395,6 +396,12 @@ ReportCase load_report_case(const std::string& dir, const std::string& name,
     const auto pivot = p.at("vm_pivot_mm").at("value").get<std::vector<double>>();
     for (std::size_t i = 0; i < 3 && i < pivot.size(); ++i) path.pivot_mm[i] = pivot[i];
     path.length_mm = p.at("vm_length_mm").at("value").get<double>();
+    if (find_vm(path.vm_kind) == nullptr) {
+      throw std::runtime_error((d / "summary.json").string() +
+                               ": the VM's parameters: unknown vm_kind '" +
+                               path.vm_kind + "' (expected one of: " +
+                               vm_kind_names() + ")");
+    }
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error((d / "summary.json").string() +
                              ": the VM's parameters: " + e.what());

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "output/svg_text.h"
+#include "studies/path_svg.h"
 
 namespace vmh::studies {
 namespace {
@@ -187,8 +188,23 @@ std::string plane_plot(const std::vector<ThesisSample>& s, const ForceFieldPath&
   g += "<text" + attr("x", px(left - 40)) + attr("y", px(top + kPlane_px / 2)) +
        attr("transform", "rotate(-90 " + px(left - 40) + " " + px(top + kPlane_px / 2) + ")") +
        " text-anchor=\"middle\">y (mm)</text>\n";
-  g += "<circle" + attr("cx", px(X(path.pivot_mm[0]))) + attr("cy", px(Y(path.pivot_mm[1]))) +
-       attr("r", px(path.length_mm * sc)) + " fill=\"none\" stroke=\"#6fa8dc\" stroke-width=\"2\"/>\n";
+  // the path as the mechanism draws it (studies/path_svg.h), in x-y
+  if (path.length_mm > 0.0) {
+    PathView pv;
+    pv.X = X;
+    pv.Y = Y;
+    pv.px_per_mm = sc;
+    pv.lo[0] = c0 - span / 2;
+    pv.lo[1] = c1 - span / 2;
+    pv.hi[0] = c0 + span / 2;
+    pv.hi[1] = c1 + span / 2;
+    g += path_elements(
+        vm_path_mm(path.vm_kind,
+                   Vec3(path.pivot_mm[0], path.pivot_mm[1], path.pivot_mm[2]),
+                   path.length_mm)
+            .primitives,
+        pv, "", attr("stroke", "#6fa8dc") + attr("stroke-width", "2"));
+  }
   // the trajectory in 200 pieces, each in the colour of its time
   const double t0 = s.front().t_s, t1 = std::max(s.back().t_s, t0 + 1e-9);
   const std::size_t pieces = 200;
@@ -297,6 +313,12 @@ std::string thesis_svg(const std::vector<ThesisSample>& samples,
     return svg + "<text x=\"10\" y=\"30\">thesis figures: fewer than two rows</text>\n</svg>\n";
   }
   const bool bands = static_cast<int>(samples.size()) > columns;
+  const bool planar =
+      path.length_mm > 0.0 &&
+      vm_path_mm(path.vm_kind,
+                 Vec3(path.pivot_mm[0], path.pivot_mm[1], path.pivot_mm[2]),
+                 path.length_mm)
+          .planar;
   svg += "<text x=\"10\" y=\"18\" font-size=\"13\">" +
          escape("The VM's joint against time, theta_V (red) and theta_R (green), and "
                 "the RM wrist centre in the mechanism's plane coloured by time") +
@@ -305,8 +327,8 @@ std::string thesis_svg(const std::vector<ThesisSample>& samples,
          escape(bands ? std::to_string(samples.size()) + " ticks: each pixel column's "
                         "minimum to maximum as a band, its mean as a line"
                       : std::to_string(samples.size()) + " ticks, every one drawn") +
-         escape(path.vm_kind == "circle" ? "; right: the circle's plane (device x-y)"
-                                         : "; right: the x-y projection") +
+         escape(planar ? "; right: the " + path.vm_kind + "'s plane (device x-y)"
+                       : std::string("; right: the x-y projection")) +
          "</text>\n";
   for (std::size_t k = 0; k < dof; ++k) {
     svg += time_plot(samples, k, kTop_px + static_cast<double>(k) * (kPlotH_px + kGap_px),

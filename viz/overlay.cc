@@ -56,40 +56,50 @@ void add_circle(const ToWorld& w, const Vec3& centre, const Vec3& u,
   }
 }
 
+// the path as the mechanism's drawing hook gives it: circles as n
+// segments, a sphere as its three great circles in the pivot frame's
+// planes, a line as a segment of the surface grid's half width each side of
+// X(theta_V)'s foot, a plane as a square grid centred under X(theta_V)
 void add_path(const VirtualMechanism& vm, const ToWorld& w,
               const ControlOutput& out, const OverlayOptions& opt,
               std::vector<OverlayPrimitive>* prims) {
-  const VmMount& m = vm.mount();
-  const Vec3 x = m.R.col(0), y = m.R.col(1), z = m.R.col(2);
-  switch (vm.kind()) {
-    case VmKind::kCircle:
-      add_circle(w, m.origin, x, y, vm.length(), opt, prims);
-      break;
-    case VmKind::kSphere:
-      add_circle(w, m.origin, x, y, vm.length(), opt, prims);
-      add_circle(w, m.origin, x, z, vm.length(), opt, prims);
-      add_circle(w, m.origin, y, z, vm.length(), opt, prims);
-      break;
-    case VmKind::kSurface: {
-      // the plane the tip slides on, a square grid centred under X(theta_V)
-      const Vec3 xv_lu = out.x_v_mm / w.unit_mm;
-      Vec3 r = m.R.transpose() * (xv_lu - m.origin);
-      r.z() = 0.0;
-      const Vec3 c = m.origin + m.R * r;
-      const double h = opt.surface_half_width_m * 1000.0 / w.unit_mm;
-      const int n = opt.surface_lines < 2 ? 2 : opt.surface_lines;
-      for (int i = 0; i < n; ++i) {
-        const double s = -h + 2.0 * h * i / (n - 1);
-        prims->push_back(segment(OverlayId::kPath,
-                                 w.point(c + s * x - h * y),
-                                 w.point(c + s * x + h * y),
-                                 opt.line_radius_m, kPathRgba));
-        prims->push_back(segment(OverlayId::kPath,
-                                 w.point(c - h * x + s * y),
-                                 w.point(c + h * x + s * y),
-                                 opt.line_radius_m, kPathRgba));
+  const Vec3 xv_lu = out.x_v_mm / w.unit_mm;
+  const double h = opt.surface_half_width_m * 1000.0 / w.unit_mm;
+  for (const PathPrimitive& prim : vm.path_primitives()) {
+    const Vec3 x = prim.u, y = prim.v, z = prim.u.cross(prim.v);
+    switch (prim.type) {
+      case PathPrimitive::Type::kCircle:
+        add_circle(w, prim.centre, x, y, prim.radius, opt, prims);
+        break;
+      case PathPrimitive::Type::kSphere:
+        add_circle(w, prim.centre, x, y, prim.radius, opt, prims);
+        add_circle(w, prim.centre, x, z, prim.radius, opt, prims);
+        add_circle(w, prim.centre, y, z, prim.radius, opt, prims);
+        break;
+      case PathPrimitive::Type::kLine: {
+        const Vec3 c = prim.centre + x.dot(xv_lu - prim.centre) * x;
+        prims->push_back(segment(OverlayId::kPath, w.point(c - h * x),
+                                 w.point(c + h * x), opt.line_radius_m,
+                                 kPathRgba));
+        break;
       }
-      break;
+      case PathPrimitive::Type::kPlane: {
+        // the plane the tip slides on, centred under X(theta_V)
+        const Vec3 c = xv_lu - z.dot(xv_lu - prim.centre) * z;
+        const int n = opt.surface_lines < 2 ? 2 : opt.surface_lines;
+        for (int i = 0; i < n; ++i) {
+          const double s = -h + 2.0 * h * i / (n - 1);
+          prims->push_back(segment(OverlayId::kPath,
+                                   w.point(c + s * x - h * y),
+                                   w.point(c + s * x + h * y),
+                                   opt.line_radius_m, kPathRgba));
+          prims->push_back(segment(OverlayId::kPath,
+                                   w.point(c - h * x + s * y),
+                                   w.point(c + h * x + s * y),
+                                   opt.line_radius_m, kPathRgba));
+        }
+        break;
+      }
     }
   }
 }

@@ -436,7 +436,7 @@ TEST(CtlErrors, BadInputIsAUsageErrorNamingTheOption) {
   const std::string q = " --q 0,0,0,0,0,0";
   expect_ctl_usage_error("ctl --vm cube" + q,
                      "--vm: unknown value 'cube' (expected one of: circle, "
-                     "sphere, surface)");
+                     "sphere, surface, line)");
   expect_ctl_usage_error("ctl --q 0,0,0,0,0", "--q: expected 6");
   expect_ctl_usage_error("ctl --q 0,0,x,0,0,0", "item 3 'x' is not a number");
   expect_ctl_usage_error("ctl", "--q");

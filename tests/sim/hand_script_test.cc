@@ -305,6 +305,66 @@ TEST_P(HandScriptTest, HoldKeepsTheStartPose) {
 INSTANTIATE_TEST_SUITE_P(CircleAndSphere, HandScriptTest,
                          ::testing::Values("circle", "sphere"));
 
+// The line slider (vm_kind line) runs along the pivot frame's y axis (the
+// device y here) through the pivot. Its script, in closed form: the start
+// is the foot of the perpendicular from pivot + L dir; the off-path holds
+// stand off the line along x, toward dir's side (out) and away (in); the
+// sweep slides L phi along the line, the stylus turning with nothing.
+class LineScriptTest : public ::testing::Test {
+ protected:
+  HandScript script(const std::vector<std::string>& overrides) {
+    const std::string customs = text_field("vm_kind", "line") +
+                                numeric_field("vm_length_mm", "45") +
+                                numeric_field("vm_pivot_mm", "10 -5 3") +
+                                numeric_field("duration_s", "8") +
+                                numeric_field("script_off_mm", "25") +
+                                numeric_field("script_sweep_mm", "15") +
+                                numeric_field("script_sweep_rad", "0.35");
+    const std::string path =
+        dir_.write("line.xml", testing::custom_only_scene(customs));
+    ModelPtr m = load_model(path);
+    const CaseConfig c = CaseConfig::from_model(m.get(), path, overrides);
+    return HandScript(c, controller_params(c).vm);
+  }
+  // the target in the middle of a segment's settled half, or at a time
+  ScriptPose settled(const HandScript& s, const std::string& name) {
+    for (const ScriptSegment& g : s.segments()) {
+      if (g.name == name) return s.at(0.5 * (g.settled_from_s() + g.t1_s));
+    }
+    ADD_FAILURE() << "no segment " << name;
+    return {};
+  }
+
+  testing::MujocoGuard guard_;
+  testing::TempMjcfDir dir_;
+};
+
+TEST_F(LineScriptTest, StartsAtTheFootAndHoldsOffAcrossTheLine) {
+  for (const double side : {1.0, -1.0}) {  // script_dir's x as given, mirrored
+    const Vec3 dir = Vec3(side * -0.35, 0.65, 0.65).normalized();
+    const HandScript s = script(
+        {"script_dir=" + std::to_string(side * -0.35) + ",0.65,0.65"});
+    const Vec3 foot = kPivot_mm + Vec3(0.0, kLength_mm * dir.y(), 0.0);
+    const Vec3 out(side * -1.0, 0.0, 0.0);  // toward dir's side, in the plane
+    EXPECT_LT((s.start_mm() - foot).norm(), 1e-12);
+    EXPECT_LT((s.outward() - out).norm(), 1e-12);
+    EXPECT_LT((settled(s, "off_out").p_mm - (foot + kOff_mm * out)).norm(),
+              1e-12);
+    EXPECT_LT((settled(s, "off_in").p_mm - (foot - kOff_mm * out)).norm(),
+              1e-12);
+    EXPECT_LT((settled(s, "on_misaligned_a").p_mm - foot).norm(), 1e-12);
+    // a quarter into the sweep: phi = sweep_rad, across = 0, along the
+    // tangent z x out
+    const ScriptSegment& sweep = s.segments().back();
+    ASSERT_EQ(sweep.name, "sweep");
+    const ScriptPose q = s.at(sweep.t0_s + 0.25 * (sweep.t1_s - sweep.t0_s));
+    const Vec3 tangent = Vec3::UnitZ().cross(out);
+    EXPECT_LT((q.p_mm - (foot + kLength_mm * kSweep_rad * tangent)).norm(),
+              1e-9);
+    EXPECT_LT((q.axis - dir).norm(), 1e-12);  // the stylus did not turn
+  }
+}
+
 // A circle whose plane the start direction is normal to has no start point
 // on its path: refused, naming the scene and script_dir.
 TEST(HandScriptErrorTest, DirectionAlongTheCircleNormalIsRefused) {

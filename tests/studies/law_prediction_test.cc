@@ -84,12 +84,13 @@ TEST(LawPrediction, CircleOnThePathIsTheTangentialClosedForm) {
 // and exact readings, commands the predicted force: two implementations of
 // eq. 3.11 (angle Jacobians of eq. 3.27/3.31 and its projector code against
 // the rigid rotations and a generic solve), for the circle and the sphere
-// under both error formulations, unlimited and with the default limits.
+// under both error formulations, unlimited and with the default limits; the
+// line slider's hook (the foot of the perpendicular, J_V = [y; 0]) the same.
 TEST(LawPrediction, AgreesWithTheControllerOnRandomPoses) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int compared = 0, limited = 0;
-  for (const VmKind kind : {VmKind::kCircle, VmKind::kSphere}) {
+  for (const VmKind kind : {VmKind::kCircle, VmKind::kSphere, VmKind::kLine}) {
     for (const ErrorFormulation err :
          {ErrorFormulation::kThesis, ErrorFormulation::kGeometric}) {
       for (const bool limits : {false, true}) {
@@ -135,6 +136,33 @@ TEST(LawPrediction, AgreesWithTheControllerOnRandomPoses) {
   }
   EXPECT_GT(compared, 300);
   EXPECT_GT(limited, 20);  // the limits were exercised
+}
+
+// The line, by hand: K_pos times the offset, normal to the line, whatever
+// the stylus; X(theta_R) = X(theta_V)
+TEST(LawPrediction, LineIsTheSpringToTheLineAlone) {
+  ControllerParams p = circle_params();
+  p.vm.kind = VmKind::kLine;
+  p.gains.k_ornt_Nmm_per_rad = thesis_orientation_gain(0.5, 50.0);
+  p.force_limit_N = 1e9;
+  p.omni.motor_torque_limit_Nm = {1e9, 1e9, 1e9};
+  for (const ErrorFormulation err :
+       {ErrorFormulation::kThesis, ErrorFormulation::kGeometric}) {
+    p.error = err;
+    // 7 mm off the line (device y through the pivot), 30 mm along it
+    const Vec3 at = p.vm.pivot_mm + Vec3(-7.0, 30.0, 4.0);
+    for (const Vec3& axis : {Vec3(0, 0, 1), Vec3(0.6, 0.0, 0.8),
+                             Vec3(0.0, 0.8, 0.6)}) {
+      const LawPrediction lp =
+          predict_static_law(p, at, axis, Joints::Zero());
+      ASSERT_TRUE(lp.available) << lp.reason;
+      EXPECT_LT((lp.x_v_mm - (p.vm.pivot_mm + Vec3(0, 30, 0))).norm(), 1e-12);
+      EXPECT_LT((lp.x_r_mm - lp.x_v_mm).norm(), 1e-12);
+      EXPECT_LT((lp.force_N - p.gains.k_pos_N_per_mm * Vec3(7.0, 0.0, -4.0))
+                    .norm(),
+                1e-12);
+    }
+  }
 }
 
 TEST(LawPrediction, NoPredictionWhereThePlacementIsUndefined) {

@@ -79,7 +79,8 @@ TEST(Overlay, SpherePathIsThreeGreatCircles) {
 }
 
 TEST(Overlay, LinksEndAtTheControllersHandlePositions) {
-  for (VmKind kind : {VmKind::kCircle, VmKind::kSphere, VmKind::kSurface}) {
+  for (VmKind kind : {VmKind::kCircle, VmKind::kSphere, VmKind::kSurface,
+                      VmKind::kLine}) {
     Ticked t(kind);
     std::vector<OverlayPrimitive> prims;
     overlay_primitives(t.controller.mechanism(), t.params, t.out, {}, &prims);
@@ -97,11 +98,30 @@ TEST(Overlay, LinksEndAtTheControllersHandlePositions) {
     // the link is L long and ends at the handle
     EXPECT_NEAR((lv[0].b_m - lv[0].a_m).norm(), 0.050, 1e-12);
     EXPECT_LT((lv[0].b_m - v[0].a_m).norm(), 1e-12);
-    if (kind != VmKind::kSurface) {  // circle and sphere: from the pivot
+    if (kind == VmKind::kCircle || kind == VmKind::kSphere) {  // from the pivot
       EXPECT_LT((lv[0].a_m - device_mm_to_base(t.params.omni, Vec3::Zero()))
                     .norm(), 1e-12);
     }
   }
+}
+
+// The line slider's path: one segment on the line (device y through the
+// pivot), centred on the foot of X(theta_V), the grid's half width each way
+TEST(Overlay, LineIsASegmentOnTheLine) {
+  Ticked t(VmKind::kLine);
+  OverlayOptions opt;
+  std::vector<OverlayPrimitive> prims;
+  overlay_primitives(t.controller.mechanism(), t.params, t.out, opt, &prims);
+  const auto path = of_id(prims, OverlayId::kPath);
+  ASSERT_EQ(path.size(), 1u);
+  const Vec3 a = base_to_device_mm(t.params.omni, path[0].a_m);
+  const Vec3 b = base_to_device_mm(t.params.omni, path[0].b_m);
+  for (const Vec3& e : {a, b}) {
+    EXPECT_NEAR(e.x(), 0.0, 1e-9);
+    EXPECT_NEAR(e.z(), 0.0, 1e-9);
+  }
+  EXPECT_NEAR((b - a).norm(), 2000.0 * opt.surface_half_width_m, 1e-9);
+  EXPECT_NEAR(0.5 * (a.y() + b.y()), t.out.x_v_mm.y(), 1e-9);
 }
 
 TEST(Overlay, ForceArrowPointsAlongTheBaseFrameForce) {
