@@ -1,4 +1,4 @@
-// vmhaptics hw run [--device D] <case1..case6|scene.xml> [--duration s]
+// vmhaptics hw run [--device D] <case1..case7|scene.xml> [--duration s]
 //                  [--out DIR] [--set name=value ...] [--gain-scale x]
 //                  [--model FILE] [--emulator-fault LIST] [--clock C]
 //
@@ -220,7 +220,7 @@ void register_hw_run(CLI::App* hw) {
       "a case's controller on the device, through the servo chain and the "
       "safety layer; on the emulator, the thesis's claims checked as in `run`");
   add_hw_common(cmd, &a->common);
-  cmd->add_option("target", a->target, "case1..case6, or a scene .xml")
+  cmd->add_option("target", a->target, "case1..case7, or a scene .xml")
       ->required();
   cmd->add_option_function<double>(
          "--duration",

@@ -189,13 +189,13 @@ void register_render(CLI::App* app) {
   auto o = std::make_shared<RenderOptions>();
   CLI::App* cmd = app->add_subcommand(
       "render",
-      "headless PNG renders of a thesis case (case1..case6) or a scene file "
+      "headless PNG renders of a case (case1..case7) or a scene file "
       "at given simulated times: the MuJoCo Omni held by the simulated hand, "
       "with the virtual mechanism, the stylus axis and the commanded force "
       "drawn over it; needs a display or Xvfb (xvfb-run -a vmhaptics "
       "render ...); prints one JSON object naming the files");
   cmd->add_option("target", o->target,
-                  "case1..case6, or the path of a scene .xml")
+                  "case1..case7, or the path of a scene .xml")
       ->required();
   cmd->add_option("--t", o->times,
                   "simulated times in s, comma-separated (e.g. 0.5,1,2.5); "

@@ -1,7 +1,7 @@
 // vmhaptics report [--out DIR] [--reuse] [--jobs N] [--quick]
 //
 // One self-contained HTML page, DIR/report.html, with the thesis's figures
-// for each of the six cases, every measured claim, error against run time,
+// for each of the seven cases, every measured claim, error against run time,
 // the work-precision figure, the stability map and the extreme scenarios
 // (studies/report_html.h). It runs what it needs into DIR (the files `run
 // --all --out DIR` and `study ... --out DIR/study` write) or, with --reuse,

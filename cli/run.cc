@@ -1,4 +1,4 @@
-// vmhaptics run <case1..case6|scene.xml> [--duration s] [--out DIR]
+// vmhaptics run <case1..case7|scene.xml> [--duration s] [--out DIR]
 //                [--set name=value ...] [--json] [--model FILE]
 // vmhaptics run --all [--out DIR] [--jobs N] [--sides fitted|full]
 //                [--trace-sides]
@@ -118,7 +118,7 @@ void run(const RunOptions& o) {
   std::vector<std::pair<std::string, std::string>> jobs;
   try {
     if (o.all) {
-      for (const sim::CaseEntry& c : sim::thesis_cases()) {
+      for (const sim::CaseEntry& c : sim::case_catalogue()) {
         std::string name;
         jobs.emplace_back(c.name, sim::resolve_scene(c.name, &name));
       }
@@ -224,12 +224,14 @@ void register_run(CLI::App* app) {
   auto o = std::make_shared<RunOptions>();
   CLI::App* cmd = app->add_subcommand(
       "run",
-      "closed-loop simulation of a thesis case (case1..case6) or a scene "
-      "file: the Omni held by a simulated hand, headless; prints the error "
-      "against run time and checks the thesis's claims");
+      "closed-loop simulation of a case (case1..case6 the thesis's, case7 "
+      "the line slider) or a scene file: the Omni held by a simulated hand, "
+      "headless; prints the error against run time and checks the case's "
+      "claims");
   cmd->add_option("target", o->target,
-                  "case1..case6, or the path of a scene .xml");
-  cmd->add_flag("--all", o->all, "run the six thesis cases");
+                  "case1..case7, or the path of a scene .xml");
+  cmd->add_flag("--all", o->all,
+                "run the seven cases: the thesis's six and the line slider");
   cmd->add_option_function<std::string>(
       "--duration",
       [o](const std::string& text) {

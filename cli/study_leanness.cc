@@ -24,7 +24,7 @@ namespace vmh::cli {
 namespace {
 
 struct LeannessCli {
-  std::vector<std::string> cases;  // empty: the six
+  std::vector<std::string> cases;  // empty: the seven
   double duration_s = studies::LeannessOptions{}.duration_s;
   int repeats = studies::LeannessOptions{}.repeats;
   std::vector<std::string> sets;
@@ -37,7 +37,7 @@ void run(const LeannessCli& o) {
   StopSignals signals;
   studies::LeannessOptions p;
   if (o.cases.empty()) {
-    for (const sim::CaseEntry& c : sim::thesis_cases()) {
+    for (const sim::CaseEntry& c : sim::case_catalogue()) {
       std::string name;
       const std::string scene = study_scene("--case", c.name, &name);
       p.scenes.emplace_back(name, scene);
@@ -90,8 +90,8 @@ void register_study_leanness(CLI::App* study) {
       "steps per second of each case's scene as composed against the same "
       "scene with contacts, gravity and a viewer's scene update switched on");
   cmd->add_option("--case", o->cases,
-                  "1..6, case1..case6 or a scene file; repeatable (default "
-                  "the six cases)")
+                  "1..7, case1..case7 or a scene file; repeatable (default "
+                  "the seven cases)")
       ->allow_extra_args(false);
   cmd->add_option("--duration", o->duration_s,
                   "simulated seconds per variant and repeat; the case's "

@@ -188,7 +188,7 @@ void register_study_precision(CLI::App* study) {
       "trajectory error against wall time for each MuJoCo integrator and a "
       "ladder of physics steps, against an RK4 reference (quantisation off)");
   cmd->add_option("--case", o->case_name,
-                  "1..6, case1..case6 or a scene file (default 1)");
+                  "1..7, case1..case7 or a scene file (default 1)");
   cmd->add_option("--duration", o->duration_s,
                   "simulated seconds from the start of the case's script "
                   "(default 3: the settle, the move off the path and the "

@@ -90,7 +90,7 @@ std::vector<std::string> case_names(const std::vector<std::string>& given) {
   }
   std::vector<std::string> out;
   if (items.empty()) {
-    for (const auto& c : sim::thesis_cases()) out.push_back(c.name);
+    for (const auto& c : sim::case_catalogue()) out.push_back(c.name);
     return out;
   }
   for (const std::string& item : items) {
@@ -99,7 +99,7 @@ std::vector<std::string> case_names(const std::vector<std::string>& given) {
     // a thesis case by its name, so that the plan names it the same way
     // whichever spelling was given; a scene file by its path
     bool known = false;
-    for (const auto& c : sim::thesis_cases()) known |= name == c.name;
+    for (const auto& c : sim::case_catalogue()) known |= name == c.name;
     out.push_back(known ? name : scene);
   }
   return out;
@@ -238,8 +238,8 @@ void register_study_sensitivity(CLI::App* study) {
       "Latin-hypercube sample; per claim its holds fraction and the "
       "parameters that flip it");
   cmd->add_option("--case", o->cases,
-                  "1..6, case1..case6, a comma list or a scene file; "
-                  "repeatable (default: all six)");
+                  "1..7, case1..case7, a comma list or a scene file; "
+                  "repeatable (default: all seven)");
   cmd->add_flag("--quick", o->quick,
                 "each parameter at its low and high only, and 16 samples "
                 "(about a minute a case on 2 cores)");

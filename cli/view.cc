@@ -118,7 +118,7 @@ void view(ViewOptions o) {
     throw UsageError(std::string("view: ") + e.what());
   }
   // the thesis cases to step through with [ and ]; a scene file alone
-  for (const sim::CaseEntry& c : sim::thesis_cases()) {
+  for (const sim::CaseEntry& c : sim::case_catalogue()) {
     std::string n;
     vo.cases.push_back({c.name, sim::resolve_scene(c.name, &n)});
     if (n == name) vo.case_index = static_cast<int>(vo.cases.size()) - 1;

@@ -13,11 +13,12 @@ namespace vmh::sim {
 
 namespace fs = std::filesystem;
 
-const std::vector<CaseEntry>& thesis_cases() {
+const std::vector<CaseEntry>& case_catalogue() {
   static const std::vector<CaseEntry> cases = {
       {"case1", "cases/case1.xml"}, {"case2", "cases/case2.xml"},
       {"case3", "cases/case3.xml"}, {"case4", "cases/case4.xml"},
       {"case5", "cases/case5.xml"}, {"case6", "cases/case6.xml"},
+      {"case7", "cases/case7.xml"},
   };
   return cases;
 }
@@ -29,7 +30,7 @@ std::string models_dir() {
 }
 
 std::string resolve_scene(const std::string& case_or_path, std::string* name) {
-  for (const CaseEntry& c : thesis_cases()) {
+  for (const CaseEntry& c : case_catalogue()) {
     if (case_or_path == c.name) {
       *name = c.name;
       return (fs::path(models_dir()) / c.scene).string();
@@ -52,7 +53,7 @@ std::string resolve_scene(const std::string& case_or_path, std::string* name) {
     throw SimError("'" + case_or_path + "': " + ec.message());
   }
   std::string known;
-  for (const CaseEntry& c : thesis_cases()) known += std::string(" ") + c.name;
+  for (const CaseEntry& c : case_catalogue()) known += std::string(" ") + c.name;
   throw SimError("'" + case_or_path +
                  "' is neither a case (" + known.substr(1) +
                  ") nor an existing scene file");

@@ -1,6 +1,7 @@
-// The thesis's six cases by name, and where their scenes are: the one place
-// that turns "case1" into a scene file, for `run`, `hw run`, `view`, the
-// studies and the emulator alike.
+// The cases by name, and where their scenes are: the one place that turns
+// "case1" into a scene file, for `run`, `hw run`, `view`, the studies and
+// the emulator alike. Cases 1-6 are the thesis's six; case 7 is this
+// project's line slider (the circle's limit, docs/testbed.md).
 #ifndef VMHAPTICS_SIM_CASE_CATALOGUE_H_
 #define VMHAPTICS_SIM_CASE_CATALOGUE_H_
 
@@ -9,13 +10,13 @@
 
 namespace vmh::sim {
 
-// The thesis's six cases, in order: name and scene file under the models
-// directory. Adding a case is one line here and one file in models/cases/.
+// The cases, in order: name and scene file under the models directory.
+// Adding a case is one line here and one file in models/cases/.
 struct CaseEntry {
   const char* name;
   const char* scene;
 };
-const std::vector<CaseEntry>& thesis_cases();
+const std::vector<CaseEntry>& case_catalogue();
 
 // The models directory: $VMH_MODELS_DIR if set, else the source tree's.
 std::string models_dir();

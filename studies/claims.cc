@@ -303,8 +303,9 @@ constexpr const char* kStaticNote =
     "the static law (e_dot = 0) at the ground-truth poses, closed-form "
     "placement, limits included (studies/law_prediction.h)";
 
-// Cases 1 and 5, position error only: no force on the path, and off it a
-// force toward X(theta_V). (The thesis's third statement, "independent of
+// Cases 1 and 5, position error only, and case 7 (the line, whose law
+// reads no orientation): no force on the path, and off it a force toward
+// X(theta_V). (The thesis's third statement, "independent of
 // X(theta_R)", is the first one again: with K_ornt = 0 nothing in the law
 // reads X(theta_R), so on the path the force is K_pos times the distance.)
 void position_claims(const std::vector<TickRecord>& rows, const HandScript& script,
@@ -571,14 +572,65 @@ void force_grows_claim(const std::vector<TickRecord>& rows,
   claims->push_back(c);
 }
 
+// Case 7, the line slider (controller/vm_line.h): whatever the hand does
+// along the line, the force has no part along it; the circle's bending
+// force has gone with its curvature.
+void line_sweep_claim(const std::vector<TickRecord>& rows,
+                      const HandScript& script, const Predictions& pred,
+                      std::vector<Claim>* claims) {
+  const std::set<std::string> sweep = {"sweep"};
+  const Vec3 t = pred.params().vm.R_pivot.col(1);  // the line's direction
+  // the force's angle from the plane normal to the line (deg), where there
+  // is a force to measure it on
+  const auto off_normal_deg = [&t](const Vec3& F) {
+    const double f = F.norm();
+    if (!(f > 0.05)) return std::nan("");
+    return std::asin(std::min(1.0, std::abs(F.dot(t)) / f)) * kRadToDeg;
+  };
+  double worst = 0.0, worst_p = 0.0;
+  int n = 0, np = 0;
+  for (const TickRecord& r : rows) {
+    if (script.segments()[static_cast<std::size_t>(r.segment)].name != "sweep")
+      continue;
+    const double a = off_normal_deg(r.out.force_device_N);
+    if (std::isfinite(a)) {
+      worst = std::max(worst, a);
+      ++n;
+    }
+    const LawPrediction& lp = pred.at(&r);
+    const double ap =
+        lp.available ? off_normal_deg(lp.force_limited_N) : std::nan("");
+    if (std::isfinite(ap)) {
+      worst_p = std::max(worst_p, ap);
+      ++np;
+    }
+  }
+  Claim c = make(
+      "sweep_force_normal_to_line",
+      "along the line the slider resists nothing: over the sweep, the "
+      "force's largest angle from the plane normal to the line (|F| > "
+      "0.05 N)",
+      sweep, n > 0 ? worst : std::nan(""), "<=", 1.0, "deg", n);
+  set_prediction(&c, np > 0 ? worst_p : std::nan(""), np, 1.0,
+                 std::string("the largest angle of ") + kStaticNote);
+  claims->push_back(c);
+}
+
 std::vector<Claim> measure_claims(int thesis_case,
                                   const std::vector<TickRecord>& rows,
                                   const sim::Case& the_case,
                                   const Predictions& pred) {
   std::vector<Claim> claims;
-  if (thesis_case < 1 || thesis_case > 6) return claims;
+  if (thesis_case < 1 || thesis_case > 7) return claims;
   const HandScript& script = the_case.script();
   const ControllerParams& p = the_case.controller_params();
+  if (thesis_case == 7) {
+    // the position claims hold with K_ornt > 0: the misaligned stylus on
+    // the line is not felt
+    position_claims(rows, script, pred, &claims);
+    line_sweep_claim(rows, script, pred, &claims);
+    return claims;
+  }
   if (!(p.gains.k_ornt_Nmm_per_rad > 0.0)) {  // cases 1 and 5
     position_claims(rows, script, pred, &claims);
     return claims;

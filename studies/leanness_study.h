@@ -57,7 +57,7 @@ struct LeannessVariant {
 const std::vector<LeannessVariant>& leanness_variants();
 
 struct LeannessOptions {
-  // case names (thesis_cases()) or scene paths; name and path each
+  // case names (case_catalogue()) or scene paths; name and path each
   std::vector<std::pair<std::string, std::string>> scenes;
   std::vector<std::string> overrides;
   double duration_s = 2.0;  // simulated per variant and repeat

@@ -114,7 +114,7 @@ struct RjPlan {
 
 RjPlan rj_plan(const ReportJob& job, const fs::path& dir, const fs::path& study_dir) {
   RjPlan plan;
-  for (const sim::CaseEntry& c : sim::thesis_cases()) {
+  for (const sim::CaseEntry& c : sim::case_catalogue()) {
     if (job.reuse && rj_all_exist(dir / c.name, {"summary.json", "trace.csv",
                                                  "views.svg", "history.svg"})) {
       plan.reused.push_back(c.name);
@@ -234,7 +234,7 @@ ReportOutcome make_report(const ReportJob& job) {
   rj_run(job, &plan, dir, precision, map, kept);
 
   ReportInputs in;
-  for (const sim::CaseEntry& c : sim::thesis_cases()) {
+  for (const sim::CaseEntry& c : sim::case_catalogue()) {
     runtime::throw_if_stopped("report", kept);
     try {
       in.cases.push_back(load_report_case(dir.string(), c.name, job.render));

@@ -23,8 +23,8 @@ using nlohmann::json;
 using vmh::testing::run;
 using vmh::testing::read_file;
 
-const std::vector<std::string> kCases = {"case1", "case2", "case3",
-                                         "case4", "case5", "case6"};
+const std::vector<std::string> kCases = {"case1", "case2", "case3", "case4",
+                                         "case5", "case6", "case7"};
 
 TEST(ReportCliTest, QuickWritesThePageAndReuseTakesItsFiles) {
   const fs::path dir = vmh::testing::fresh_dir("vmh_report_cli_", "quick");
@@ -69,13 +69,13 @@ TEST(ReportCliTest, QuickWritesThePageAndReuseTakesItsFiles) {
   // (VMH_EXPECT_RENDERS); elsewhere each case must say why it has none.
 #ifdef VMH_EXPECT_RENDERS
   EXPECT_EQ(vmh::testing::count(html, "src=\"data:image/png;base64,iVBORw0KGgo"),
-            6) << first.err;
+            7) << first.err;
   EXPECT_EQ(html.find("render unavailable"), std::string::npos);
   for (const std::string& c : kCases) {
     EXPECT_FALSE(fs::is_empty(dir / c / "render")) << c;
   }
 #else
-  EXPECT_EQ(vmh::testing::count(html, "render unavailable: "), 6);
+  EXPECT_EQ(vmh::testing::count(html, "render unavailable: "), 7);
 #endif
   for (const char* f : {"precision.svg", "stability_map.svg", "extremes.json"}) {
     EXPECT_TRUE(fs::exists(dir / "study" / f)) << f;

@@ -179,9 +179,9 @@ TEST(RunCli, MissingFieldIsNamed) {
 }
 
 TEST(RunCli, UnknownCaseAndUsage) {
-  auto r = run("run case7");
+  auto r = run("run case8");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("'case7'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("'case8'"), std::string::npos) << r.err;
   r = run("run");
   EXPECT_EQ(r.exit_code, 2);
   r = run("run case1 --all");
@@ -222,7 +222,7 @@ TEST(RunCli, DurationIsCheckedBeforeAnyWork) {
                  {"duration_s (1e-07 s) must last from 1 to 1000000000 servo "
                   "periods"});
   // and the check comes before the scene is even looked for
-  expect_refused("run case7 --duration 1e308", {"--duration"});
+  expect_refused("run case8 --duration 1e308", {"--duration"});
 }
 
 TEST(RunCli, TimingParametersAreBounded) {

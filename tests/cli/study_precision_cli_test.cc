@@ -127,7 +127,7 @@ TEST(StudyLeannessCli, BadOptionsAreNamed) {
     const char* args;
     const char* names;
   } bad[] = {
-      {"--case 7", "--case"},
+      {"--case 8", "--case"},
       {"--duration -2", "--duration"},
       {"--repeats 0", "--repeats"},
       {"--set quantize=2", "quantize"},

@@ -440,7 +440,7 @@ INSTANTIATE_TEST_SUITE_P(
         // whole numbers within a range
         num("delay_ticks", "-1"), num("delay_ticks", "65"),
         num("delay_ticks", "1.5"), num("quantize", "2"), num("quantize", "0.5"),
-        num("thesis_case", "7"),
+        num("thesis_case", "8"),
         // weights and inertias
         num("placement_weights", "1 1 1 -1 0 0"),
         num("projection_weights", "1 1 1 1 1 -0.1"),

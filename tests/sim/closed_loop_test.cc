@@ -50,7 +50,7 @@ TEST_P(CaseTest, RunsWithoutWarningOrFault) {
   EXPECT_NEAR(loop.time_s(), 20.0, 1e-9);
 }
 
-INSTANTIATE_TEST_SUITE_P(ThesisCases, CaseTest, ::testing::Range(1, 7));
+INSTANTIATE_TEST_SUITE_P(ThesisCases, CaseTest, ::testing::Range(1, 8));
 
 // Zero-order hold: the motors hold the same torque over every physics step
 // of a servo tick; the torque changes only at tick boundaries.

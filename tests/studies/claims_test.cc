@@ -144,7 +144,7 @@ TEST(CaseSix, GeometricErrorHoldsOnBothSides) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(ThesisCases, CaseTest, ::testing::Range(1, 7));
+INSTANTIATE_TEST_SUITE_P(ThesisCases, CaseTest, ::testing::Range(1, 8));
 
 }  // namespace
 }  // namespace vmh::studies

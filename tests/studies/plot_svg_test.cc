@@ -177,6 +177,27 @@ TEST(PlotSvgTest, CircleHasTwoPanelsSphereThreeProjectionsEach) {
   }
 }
 
+// The line slider (case 7): one view in its plane, like the circle, its
+// path a line through the pivot along the device y axis (x1 = x2 at the
+// pivot's x, spanning the frame), no thesis figures to cite
+TEST(PlotSvgTest, LineIsDrawnAsALineInItsPlane) {
+  const CaseRun& r = run(7);
+  const std::string& v = r.views;
+  EXPECT_EQ(count(v, "class=\"panel\""), 2u);
+  EXPECT_EQ(count(v, "line plane (device x-y)"), 2u);
+  EXPECT_EQ(count(v, "cf. thesis Figs"), 0u);
+  EXPECT_EQ(count(v, "VM path: line, L = 50 mm"), 1u);
+  for (const char* tag : {"off", "on"}) {
+    const auto path = element(v, std::string("path-") + tag);
+    ASSERT_EQ(path.at("<name>"), "line") << tag;
+    const auto pivot = element(v, std::string("xv-") + tag);  // from the pivot
+    ASSERT_FALSE(pivot.empty()) << tag;
+    EXPECT_NEAR(number(path, "x1"), number(path, "x2"), 1e-9) << tag;
+    EXPECT_NEAR(number(path, "x1"), number(pivot, "x1"), 0.011) << tag;
+    EXPECT_GT(std::abs(number(path, "y1") - number(path, "y2")), 300.0) << tag;
+  }
+}
+
 // The circle's views: the arrow starts at p and is kPlotForceMmPerN x F
 // (its in-plane part), read back in mm through the path circle's radius.
 TEST(PlotSvgTest, ForceArrowIsTheForceTimesTheScale) {

@@ -1,7 +1,7 @@
 // The report's page: well formed (every element closed in order), every
 // figure present (each <img> a base64 PNG, each inline <svg> balanced),
 // every case and every claim of its summary.json on it, failing claims
-// marked, and the summary's count right. Once on real runs of the six cases
+// marked, and the summary's count right. Once on real runs of the seven cases
 // and once on made-up inputs with a failing claim and a render.
 #include "studies/report_html.h"
 
@@ -142,28 +142,28 @@ TEST(ReportHtmlTest, InlineSvgDropsTheProlog) {
             "<svg a=\"1\"></svg>\n");
 }
 
-// the six cases run for real (20 s each, about half a second of wall time
+// the seven cases run for real (20 s each, about half a second of wall time
 // each), loaded from their files as `report --reuse` loads them
-TEST(ReportHtmlTest, RealRunsOfTheSixCasesAreAllOnThePage) {
+TEST(ReportHtmlTest, RealRunsOfTheSevenCasesAreAllOnThePage) {
   const fs::path dir = fs::path(::testing::TempDir()) / "vmh_report_html_cases";
   fs::remove_all(dir);
   std::vector<CaseJob> jobs;
-  for (const sim::CaseEntry& c : sim::thesis_cases()) {
+  for (const sim::CaseEntry& c : sim::case_catalogue()) {
     std::string name;
     jobs.push_back({c.name, sim::resolve_scene(c.name, &name), {}, {}, false});
   }
-  // the progress callback, called from the two workers, ends at 6 of 6
+  // the progress callback, called from the two workers, ends at 7 of 7
   std::atomic<std::size_t> last_done{0}, calls{0};
   run_cases(&jobs, {}, dir.string(), 2, "",
             [&](std::size_t done, std::size_t total) {
-              EXPECT_EQ(total, 6u);
+              EXPECT_EQ(total, 7u);
               ++calls;
               std::size_t seen = last_done.load();
               while (done > seen && !last_done.compare_exchange_weak(seen, done)) {
               }
             });
-  EXPECT_EQ(calls.load(), 6u);
-  EXPECT_EQ(last_done.load(), 6u);
+  EXPECT_EQ(calls.load(), 7u);
+  EXPECT_EQ(last_done.load(), 7u);
   ReportInputs in;
   in.header.version = "test";
   for (const CaseJob& j : jobs) {
@@ -191,10 +191,10 @@ TEST(ReportHtmlTest, RealRunsOfTheSixCasesAreAllOnThePage) {
                       std::string(failed == 0 ? "pass" : "fail") + "\">" +
                       std::to_string(passed) + "/" + std::to_string(total)),
             std::string::npos);
-  EXPECT_EQ(testing::count(html, "render unavailable: no renderer in this build"), 6u);
-  // the force field of every case: one panel for the circles (cases 1-4),
-  // three for the spheres (5, 6)
-  EXPECT_EQ(testing::count(html, "-force-field-ff-xy\""), 6u);
+  EXPECT_EQ(testing::count(html, "render unavailable: no renderer in this build"), 7u);
+  // the force field of every case: one panel for the circles (cases 1-4)
+  // and the line (7), three for the spheres (5, 6)
+  EXPECT_EQ(testing::count(html, "-force-field-ff-xy\""), 7u);
   EXPECT_EQ(testing::count(html, "-force-field-ff-zy\""), 2u);
   // every id on the page once: the figures' own ids are prefixed per figure
   std::map<std::string, int> ids;

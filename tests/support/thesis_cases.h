@@ -1,4 +1,5 @@
-// The thesis's six case scenes (models/cases/caseN.xml) for tests that run
+// The case scenes (models/cases/caseN.xml: the thesis's six and case 7, the
+// line slider) for tests that run
 // them, and a fixture parameterised by the case number that records MuJoCo's
 // errors and warnings (mujoco_guard.h). The test needs VMH_MODELS_DIR.
 #ifndef VMHAPTICS_TESTS_SUPPORT_THESIS_CASES_H_
@@ -18,7 +19,8 @@ inline std::string thesis_case_scene(int n) {
          ".xml";
 }
 
-// TEST_P(ThesisCaseTest, ...) with INSTANTIATE_TEST_SUITE_P over 1..6
+// TEST_P(ThesisCaseTest, ...) with INSTANTIATE_TEST_SUITE_P over 1..6 (the
+// thesis's), or 1..7 with the line slider
 class ThesisCaseTest : public ::testing::TestWithParam<int> {
  protected:
   MujocoGuard guard_;
