@@ -27,13 +27,6 @@ std::uint64_t next_random(std::uint64_t* state) {
 // a number in a message: %g-style, 9 significant digits (1e-07, 0.001)
 std::string num(double v) { return detail::format_number(v); }
 
-bool all_finite(const mjtNum* v, int n) {
-  for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(v[i])) return false;
-  }
-  return true;
-}
-
 // the stylus rotation (DH base frame) whose z axis is `axis_base`, reached
 // from `R_ref` by the smallest rotation
 Mat3 turn_to_axis(const Mat3& R_ref, const Vec3& axis_base) {
@@ -61,49 +54,45 @@ ClosedLoop::ClosedLoop(const std::string& scene_path,
                        const std::vector<std::string>& overrides,
                        const ModelHook& model_hook)
     : path_(scene_path),
-      model_(load_scene_model(scene_path, model_hook)),
-      case_(make_case(scene_path, *model_, overrides)) {
+      plant_(load_scene_model(scene_path, model_hook), scene_path),
+      case_(make_case(scene_path, *plant_.model(), overrides)) {
   init();
 }
 
 ClosedLoop::ClosedLoop(const std::string& scene_path, const mjModel& compiled,
                        const std::vector<std::string>& overrides)
     : path_(scene_path),
-      model_(copy_model(compiled, scene_path)),
-      case_(make_case(scene_path, *model_, overrides)) {
+      plant_(copy_model(compiled, scene_path), scene_path),
+      case_(make_case(scene_path, *plant_.model(), overrides)) {
   init();
 }
 
 ClosedLoop::ClosedLoop(const Case& c, const ModelHook& model_hook)
     : path_(c.scene_path()),
-      model_(load_scene_model(c.scene_path(), model_hook)),
+      plant_(load_scene_model(c.scene_path(), model_hook), c.scene_path()),
       case_(c) {
   init();
 }
 
 void ClosedLoop::init() {
   apply_model_options();
-  data_.reset(mj_makeData(model_.get()));
-  if (!data_) throw SimError(path_ + ": mj_makeData failed");
-  hand_ = std::make_unique<SimHand>(model_.get(), data_.get(),
+  plant_.make_data();
+  hand_ = std::make_unique<SimHand>(plant_.mutable_model(), plant_.data(),
                                     hand_params(case_.config()), path_);
   {
     // the grip site's offset and rotation in the stylus body, fixed
     const int g = hand_->grip_site();
-    grip_local_ = Vec3(model_->site_pos + 3 * g);
-    mju_quat2Mat(R_site_.data(), model_->site_quat + 4 * g);
+    grip_local_ = Vec3(plant_.model()->site_pos + 3 * g);
+    mju_quat2Mat(R_site_.data(), plant_.model()->site_quat + 4 * g);
   }
   build_controller();
   build_device_chain();
-  qpos_before_.assign(static_cast<std::size_t>(model_->nq), 0.0);
-  dq_.assign(static_cast<std::size_t>(model_->nv), 0.0);
-  mv_.assign(static_cast<std::size_t>(model_->nv), 0.0);
   q_start_dh_ = start_pose();
   reset();
 }
 
 void ClosedLoop::apply_model_options() {
-  mjModel* m = model_.get();
+  mjModel* m = plant_.mutable_model();
   const SimSettings& sim = case_.config().sim;
   if (sim.physics_step_s > 0.0) m->opt.timestep = sim.physics_step_s;
   switch (sim.integrator) {
@@ -115,7 +104,7 @@ void ClosedLoop::apply_model_options() {
 }
 
 void ClosedLoop::build_controller() {
-  mjModel* m = model_.get();
+  mjModel* m = plant_.mutable_model();
   const ControllerParams& params = case_.controller_params();
   // the case's controller has the gimbal's ranges opened without its limits
   if (!case_.config().sim.gimbal_limits) {
@@ -145,7 +134,7 @@ void ClosedLoop::build_controller() {
 
 void ClosedLoop::build_device_chain() {
   const SimSettings& sim = case_.config().sim;
-  device_ = std::make_unique<SimDevice>(model_.get(), data_.get(),
+  device_ = std::make_unique<SimDevice>(plant_.mutable_model(), plant_.data(),
                                         case_.controller_params().omni, sim.quantize,
                                         sim.delay_ticks, path_);
   FaultSpec fault;
@@ -158,7 +147,7 @@ void ClosedLoop::build_device_chain() {
   chain.mode = ChainMode::kRun;
   chain.guard.enabled = sim.sensor_guard;
   chain.guard.max_speed_rad_s = sim.guard_max_speed_rad_s;
-  chain.guard.max_period_s = case_.substeps_max() * model_->opt.timestep;
+  chain.guard.max_period_s = case_.substeps_max() * plant_.model()->opt.timestep;
   chain.controller = case_.controller_params();
   chain.safety = sim.safety_layer;
   chain.safety_params = safety_params_for(case_.controller_params());
@@ -205,12 +194,12 @@ void ClosedLoop::set_reference(const ControllerParams& params) {
 }
 
 double ClosedLoop::time_s() const {
-  if (case_.jitter()) return static_cast<double>(substep_count_) * model_->opt.timestep;
+  if (case_.jitter()) return static_cast<double>(substep_count_) * plant_.model()->opt.timestep;
   return static_cast<double>(tick_count_) * case_.controller_params().servo_period_s;
 }
 
 bool ClosedLoop::finished() const {
-  return script_time_s() >= case_.config().sim.duration_s - 0.5 * model_->opt.timestep;
+  return script_time_s() >= case_.config().sim.duration_s - 0.5 * plant_.model()->opt.timestep;
 }
 
 void ClosedLoop::skip_script_to(double t_s) {
@@ -224,18 +213,6 @@ void ClosedLoop::skip_script_to(double t_s) {
   script_skipped_s_ += t_s - now_s;
 }
 
-std::string PhysicsFault::message() const {
-  std::string where = part;
-  if (index >= 0) {
-    where += (part == "ctrl" ? ", actuator " : ", DOF ") + std::to_string(index);
-  }
-  return "physics went non-finite at t=" + num(t_s) + " s (" + where + ")";
-}
-
-void ClosedLoop::throw_if_physics_fault() const {
-  if (physics_fault_) throw PhysicsError(path_ + ": " + physics_fault_->message());
-}
-
 int ClosedLoop::draw_substeps() {
   if (!case_.jitter()) return case_.substeps();
   const auto span = static_cast<std::uint64_t>(case_.substeps_max() -
@@ -245,9 +222,9 @@ int ClosedLoop::draw_substeps() {
 }
 
 void ClosedLoop::reset() {
-  mjModel* m = model_.get();
-  mjData* d = data_.get();
-  mj_resetData(m, d);
+  const mjModel* m = plant_.model();
+  mjData* d = plant_.data();
+  plant_.reset();
   device_->reset();
   injector_->reset();
   chain_->reset();
@@ -255,12 +232,6 @@ void ClosedLoop::reset() {
   substep_count_ = 0;
   script_skipped_s_ = 0.0;
   rng_state_ = case_.config().sim.jitter_seed;
-  energy_motor_J_ = 0.0;
-  energy_hand_J_ = 0.0;
-  // mj_resetData cleared mjData::warning[]
-  warning_counts_.fill(0);
-  warning_seen_.fill(0);
-  physics_fault_.reset();
   // write the start angles through the joint addresses
   for (int i = 0; i < 6; ++i) {
     const std::string name = "q" + std::to_string(i + 1);
@@ -338,7 +309,7 @@ ScriptPose ClosedLoop::script_target(double t_s) {
   target.v_m_s = (p2 - target.p_m) / dt;
   const Eigen::AngleAxisd dR(R2 * target.R.transpose());
   target.w_rad_s = dR.angle() * dR.axis() / dt;
-  hand_->set_target(model_.get(), data_.get(), target);
+  hand_->set_target(plant_.mutable_model(), plant_.data(), target);
   return pose;
 }
 
@@ -360,7 +331,7 @@ void ClosedLoop::tick(TickRecord* row) {
   const double t_script = std::min(t, case_.config().sim.duration_s);
   row->segment = case_.script().segment_at(t_script);
   if (manual_hand_) {
-    hand_->set_target(model_.get(), data_.get(), manual_target_);
+    hand_->set_target(plant_.mutable_model(), plant_.data(), manual_target_);
     row->hand_target = wrist_pose_of(manual_target_);
   } else {
     // the script's pose at t_script, which the hand's target was made from
@@ -382,72 +353,19 @@ void ClosedLoop::tick(TickRecord* row) {
   row->p_true_mm = base_to_device_mm(omni, pose_true.p_base_m);
   row->nearest_true_mm = nearest_on_path_mm(row->p_true_mm);
 
-  mjModel* m = model_.get();
-  mjData* d = data_.get();
   const int n = draw_substeps();
-  const double h = m->opt.timestep;
-  bool bad_step = false;
-  for (int i = 0; i < n; ++i) {
-    mju_copy(qpos_before_.data(), d->qpos, m->nq);
-    const double time_before = d->time;
-    mj_step(m, d);
-    if (check_step(t + (i + 1) * h, time_before)) bad_step = true;
-    // the true motion over the step, and the work of the forces held on it
-    mj_differentiatePos(m, dq_.data(), 1.0, qpos_before_.data(), d->qpos);
-    energy_motor_J_ += mju_dot(d->qfrc_actuator, dq_.data(), m->nv);
-    energy_hand_J_ += mju_dot(d->qfrc_applied, dq_.data(), m->nv);
-  }
+  const bool steps_finite = plant_.step(n, t);
   row->substeps = n;
-  row->period_s = n * m->opt.timestep;
-  row->energy_motor_J = energy_motor_J_;
-  row->energy_hand_J = energy_hand_J_;
-  mj_mulM(m, d, mv_.data(), d->qvel);
-  row->kinetic_J = 0.5 * mju_dot(d->qvel, mv_.data(), m->nv);
+  row->period_s = n * plant_.model()->opt.timestep;
+  row->energy_motor_J = plant_.energy_motor_J();
+  row->energy_hand_J = plant_.energy_hand_J();
+  row->kinetic_J = plant_.kinetic_J();
   // MuJoCo resets a bad state, so the state after the tick may look fine
-  row->state_finite = !bad_step && all_finite(d->qpos, m->nq) &&
-                      all_finite(d->qvel, m->nv) && all_finite(d->qacc, m->nv) &&
-                      all_finite(d->ctrl, m->nu);
+  row->state_finite = steps_finite && plant_.state_finite();
   row->hand_force_N = base_to_device_vector(hand_->force_N());
   row->has_truth = true;
   ++tick_count_;
   substep_count_ += n;
-}
-
-bool ClosedLoop::check_step(double t_s, double time_before) {
-  const mjModel* m = model_.get();
-  const mjData* d = data_.get();
-  // mj_step's checks (mj_checkPos, mj_checkVel, mj_checkAcc) count a bad
-  // value in d->warning[] and reset the state, which clears the counters
-  // (and MuJoCo's clock) before counting it: after a reset every count is
-  // new. A step that did not move MuJoCo's clock forward was reset
-  const bool reset = !(d->time > time_before);
-  bool bad = false;
-  for (int k = 0; k < mjNWARNING; ++k) {
-    const int now = d->warning[k].number;
-    const int seen = warning_seen_[static_cast<std::size_t>(k)];
-    const int added = reset || now < seen ? now : now - seen;
-    warning_seen_[static_cast<std::size_t>(k)] = now;
-    if (added == 0) continue;
-    warning_counts_[static_cast<std::size_t>(k)] += added;
-    const bool bad_kind = k == mjWARN_BADQPOS || k == mjWARN_BADQVEL ||
-                          k == mjWARN_BADQACC || k == mjWARN_BADCTRL;
-    if (bad_kind && !bad) {
-      bad = true;
-      if (!physics_fault_) {
-        static const char* const kParts[] = {"qpos", "qvel", "qacc", "ctrl"};
-        physics_fault_ = PhysicsFault{t_s, kParts[k - mjWARN_BADQPOS],
-                                      d->warning[k].lastinfo};
-      }
-    }
-  }
-  if (!bad && !(all_finite(d->qpos, m->nq) && all_finite(d->qvel, m->nv))) {
-    bad = true;
-    if (!physics_fault_) {
-      physics_fault_ = PhysicsFault{
-          t_s, all_finite(d->qpos, m->nq) ? "qvel" : "qpos", -1};
-    }
-  }
-  return bad;
 }
 
 }  // namespace vmh::sim

@@ -22,13 +22,10 @@
 // controller is still told T, as a servo loop that does not time itself
 // would be, so its e_dot is off by the ratio of the periods.
 //
-// Passivity observer (Hannaford & Ryu 2002, IEEE TRA 18(1)): the energy the
-// motors put into the device, E = sum over physics steps of
-// qfrc_actuator . (q_after - q_before), with qfrc_actuator the torque held
-// over the step and q the true joint angles. The motor torque is constant
-// over a step (ZOH, fixed tendons), so this is the exact work along the
-// integrated motion for any integrator. The hand's work is summed the same
-// way from qfrc_applied (exact for Euler; for RK4 the last stage's wrench).
+// The physics is a Plant (sim/plant.h): MuJoCo's model and data, stepped n
+// times per tick, with the passivity observer's energies, MuJoCo's warnings
+// and the first bad state. The case (sim/case.h) is the immutable part:
+// parameters, script, path. ClosedLoop is the servo chain over the plant.
 // Each loop's hand is registered for its own mjData, so loops in different
 // threads do not disturb each other.
 #ifndef VMHAPTICS_SIM_CLOSED_LOOP_H_
@@ -50,31 +47,13 @@
 #include "sim/case_config.h"
 #include "sim/fault_injector.h"
 #include "sim/omni_model_edit.h"
+#include "sim/plant.h"
 #include "sim/hand.h"
 #include "sim/hand_script.h"
 #include "sim/mujoco_util.h"
 #include "sim/sim_device.h"
 
 namespace vmh::sim {
-
-// Where MuJoCo's state went bad: the first physics step after which
-// mjData::warning[] counted a bad qpos, qvel, qacc or ctrl (NaN, inf or
-// beyond 1e10: MuJoCo then resets the state and carries on), or qpos or
-// qvel was not finite.
-struct PhysicsFault {
-  double t_s = 0.0;   // the loop's time at the end of that step
-  std::string part;   // qpos, qvel, qacc or ctrl
-  int index = -1;     // the DOF (ctrl: the actuator) MuJoCo named; -1: none
-  // "physics went non-finite at t=0.002 s (qacc, DOF 3)"
-  std::string message() const;
-};
-
-// A run stopped by a PhysicsFault: a failure of the run (exit 1), not bad
-// input.
-class PhysicsError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 // The scene at `path` compiled, `model_hook` applied (if set): what the
 // second ClosedLoop constructor copies. `headless`: without what is only
@@ -126,14 +105,14 @@ class ClosedLoop {
 
   // the first bad physics state since reset(), if any
   const std::optional<PhysicsFault>& physics_fault() const {
-    return physics_fault_;
+    return plant_.physics_fault();
   }
   // throws PhysicsError(physics_fault()->message()) if there is one
-  void throw_if_physics_fault() const;
+  void throw_if_physics_fault() const { plant_.throw_if_physics_fault(); }
   // MuJoCo's per-step warnings since reset(), by mjtWarning: every count
   // mjData::warning[] reached, summed over its resets
   const std::array<std::int64_t, mjNWARNING>& mujoco_warning_counts() const {
-    return warning_counts_;
+    return plant_.warning_counts();
   }
 
   // Another gain set evaluated on every reading, without acting
@@ -165,8 +144,8 @@ class ClosedLoop {
   int substeps_max() const { return case_.substeps_max(); }
   bool jitter() const { return case_.jitter(); }
   // the passivity observer's totals so far, J (see the file comment)
-  double energy_motor_J() const { return energy_motor_J_; }
-  double energy_hand_J() const { return energy_hand_J_; }
+  double energy_motor_J() const { return plant_.energy_motor_J(); }
+  double energy_hand_J() const { return plant_.energy_hand_J(); }
   // the case this loop runs (sim/case.h): parameters, controller, script
   // and timing, read once from the scene
   const Case& the_case() const { return case_; }
@@ -176,8 +155,11 @@ class ClosedLoop {
   }
   const HandScript& script() const { return case_.script(); }
   const Controller& controller() const { return *chain_->controller(); }
-  const mjModel* model() const { return model_.get(); }
-  mjData* data() { return data_.get(); }
+  const mjModel* model() const { return plant_.model(); }
+  mjData* data() { return plant_.data(); }
+  // the physics (model, data, energies, warnings)
+  Plant& plant() { return plant_; }
+  const Plant& plant() const { return plant_; }
   SimDevice& device() { return *device_; }
   FaultInjector& injector() { return *injector_; }
   ReadingGuard& guard() { return chain_->guard(); }
@@ -226,10 +208,6 @@ class ClosedLoop {
 
   // the next tick's physics steps (drawn when jittered)
   int draw_substeps();
-  // after a physics step that ended at t_s (MuJoCo's clock read
-  // time_before it): count MuJoCo's warnings, keep the first bad state;
-  // true if this step's state is bad
-  bool check_step(double t_s, double time_before);
   // the wrist pose (device frame) a grip target asks for
   ScriptPose wrist_pose_of(const HandTargetState& grip) const;
   // set_hand_target(t_s); returns the script's pose at min(t_s, duration_s)
@@ -239,8 +217,7 @@ class ClosedLoop {
   const Mat3& stylus_turned_to(const Vec3& axis_base);
 
   std::string path_;
-  ModelPtr model_;
-  DataPtr data_;
+  Plant plant_;  // before case_, which reads its model
   Case case_;
   std::unique_ptr<SimHand> hand_;
   std::unique_ptr<SimDevice> device_;
@@ -267,14 +244,6 @@ class ClosedLoop {
   std::int64_t substep_count_ = 0;  // physics steps since t = 0
   bool manual_hand_ = false;
   HandTargetState manual_target_;
-  // passivity observer
-  double energy_motor_J_ = 0.0;
-  double energy_hand_J_ = 0.0;
-  std::vector<mjtNum> qpos_before_, dq_, mv_;
-  // MuJoCo's warnings and the first bad state (check_step)
-  std::array<std::int64_t, mjNWARNING> warning_counts_{};
-  std::array<int, mjNWARNING> warning_seen_{};  // d->warning[].number
-  std::optional<PhysicsFault> physics_fault_;
 };
 
 }  // namespace vmh::sim
