@@ -14,30 +14,21 @@
 #include "output/output_file.h"
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
+#include "studies/study_numbers.h"
 
 namespace vmh::studies {
 // the testbed's types (sim/) by their own names in this file
 using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
+using detail::exact;
+using detail::thread_cpu_s;
+
 using Clock = std::chrono::steady_clock;
 
 // room for every geom of the Omni and the hand many times over; simulate's
 // default is 2000 for scenes far larger than these
 constexpr int kSceneMaxGeoms = 1000;
-
-// CPU time of the calling thread (s), POSIX clock_gettime
-double thread_cpu_s() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-std::string exact(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
 
 // an mjvScene with its option and camera, freed with it
 class ViewerState {

@@ -51,10 +51,10 @@ ModellingSpread read_modelling_spread(const std::string& given,
 
 nlohmann::ordered_json modelling_spread_json(const ModellingSpread& s,
                                              double numerical_error_mm) {
-  using Json = nlohmann::ordered_json;
-  auto n = [](double x) { return std::isfinite(x) ? Json(x) : Json(); };
+  using OJson = nlohmann::ordered_json;
+  auto n = [](double x) { return std::isfinite(x) ? OJson(x) : OJson(); };
   const double ratio = s.spread_mm / numerical_error_mm;
-  Json dominant;
+  OJson dominant;
   if (std::isfinite(ratio)) dominant = ratio >= 1.0 ? "modelling" : "numerical";
   return {{"source", s.source},
           {"case", s.case_name},

@@ -16,22 +16,19 @@
 #include "sim/case.h"
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
+#include "studies/study_numbers.h"
 
 namespace vmh::studies {
 // the testbed's types (sim/) by their own names in this file
 using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
+using detail::exact;
+using detail::thread_cpu_s;
+
 using Clock = std::chrono::steady_clock;
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// "%.17g": round-trips through the case loader's strtod
-std::string exact(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
 
 // What a run leaves behind, one entry per servo tick, sampled at the end of
 // the tick (t = (k + 1) T): the start state is the same for every run.
@@ -48,15 +45,6 @@ struct Trajectory {
   double cpu_time_s = 0.0;      // the thread's CPU time, least of the repeats
   int repeats = 0;
 };
-
-// CPU time of the calling thread (s): unlike the wall clock, it does not
-// count the time other processes held the core, which on a shared machine
-// is most of the noise (POSIX clock_gettime)
-double thread_cpu_s() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 int warning_count(const mjData* d) {
   int n = 0;

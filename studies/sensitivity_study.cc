@@ -17,9 +17,12 @@
 #include "sim/omni_model_edit.h"
 #include "studies/claims.h"
 #include "studies/run_case.h"
+#include "studies/study_numbers.h"
 
 namespace vmh::studies {
 namespace {
+
+using detail::exact;
 
 using sim::SimError;
 
@@ -36,13 +39,6 @@ SweepParameter row(const char* name, SweepKind kind, const char* field,
   p.unit = unit;
   p.source = source;
   return p;
-}
-
-// exact text of a number for an override ("%.17g" reads back the same)
-std::string exact(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
 }
 
 // the value at u in [0, 1) of the parameter's range (samples)
