@@ -22,6 +22,7 @@
 #include "sim/case_catalogue.h"
 #include "sim/closed_loop.h"
 #include "studies/claims.h"
+#include "studies/summary_json.h"
 #include "studies/stop.h"
 
 namespace vmh::studies {
@@ -105,17 +106,6 @@ void run_cases(std::vector<CaseJob>* jobs,
                const output::ProgressFn& progress = {},
                const StopFn& stop = {},
                const CaseRunOptions& options = {});
-
-// summary.json's pieces, for other writers of the same format (hw run)
-nlohmann::json claim_json(const Claim& c);
-nlohmann::json metrics_json(const RunMetrics& m);
-// summary.json's "mujoco_warnings": {count, kinds, messages}: the per-step
-// warnings by kind (ClosedLoop::mujoco_warning_counts) plus what else
-// MuJoCo said, and every text MuJoCo wrote, deduplicated
-// (sim/mujoco_messages.h; docs/outputs.md)
-nlohmann::json mujoco_warnings_json(
-    const std::array<std::int64_t, mjNWARNING>& per_step,
-    const sim::MujocoWarningTally& messages);
 
 // trace.csv's column names for a loop, in order (runtime/trace_writer.h
 // writes it, as it writes a session's)
