@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "studies/html_parts.h"
+
 namespace vmh::studies {
 
 // A render of a case's scene as PNG file bytes, or nullopt with *why_not
@@ -71,12 +73,6 @@ struct ReportInputs {
 ReportCase load_report_case(const std::string& dir, const std::string& name,
                             const RenderFn& render);
 
-// A whole file's bytes, "" when there is no file. Only a regular file of
-// at most kMaxReusedFileBytes is read (opened without blocking): anything
-// else throws std::runtime_error naming it (a FIFO, a device, its size).
-inline constexpr std::uint64_t kMaxReusedFileBytes = std::uint64_t{1} << 30;
-std::string read_file_text(const std::string& path);
-
 // claims over every case's summary.json
 struct ClaimTally {
   int passed = 0;
@@ -91,18 +87,6 @@ ClaimTally tally_claims(const std::vector<ReportCase>& cases);
 
 // the page
 std::string report_html(const ReportInputs& in);
-
-// RFC 4648 base64, with padding
-std::string base64(const std::string& bytes);
-
-// An SVG document ready to sit inside HTML: any XML prolog or DOCTYPE before
-// the <svg> element dropped, and, with a non-empty `id_prefix`, every id it
-// defines and every reference to one (url(#x), href="#x") prefixed, so that
-// figures inlined in one page cannot share an id. (Two figures that each
-// define id="plot-clip" would otherwise both be clipped by the first
-// definition's rectangle, and lose points: issue 31.)
-std::string inline_svg(const std::string& svg_document,
-                       const std::string& id_prefix = "");
 
 }  // namespace vmh::studies
 
