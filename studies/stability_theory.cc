@@ -6,6 +6,8 @@
 #include <sstream>
 #include <string>
 
+#include "controller/types.h"
+
 namespace vmh::studies {
 // the testbed's types (sim/) by their own names in this file
 using namespace vmh::sim;  // NOLINT(build/namespaces)
