@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "controller/types.h"
 #include "output/parallel.h"
 
 namespace vmh::studies {
