@@ -9,16 +9,15 @@
 #include "output/output_file.h"
 #include "output/svg_chart.h"
 #include "sim/case.h"
+#include "bringup/compare_text.h"
 #include "sim/closed_loop.h"
 
 namespace vmh::bringup {
 namespace {
 
-std::string replay_fmt(double v, int precision = 4) {
-  std::ostringstream s;
-  s.precision(precision);
-  s << v;
-  return s.str();
+// four significant digits unless asked otherwise
+std::string replay_fmt(double v, int digits = 4) {
+  return detail::significant(v, digits);
 }
 
 bool text_is(const Recording& r, const char* column, std::size_t row,
