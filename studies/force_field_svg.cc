@@ -101,25 +101,11 @@ std::string panel(const std::vector<ForceSample>& s,
     }
   }
   // the path as the mechanism draws it (studies/path_svg.h)
-  if (path.length_mm > 0.0) {
-    PathView pv;
-    pv.a = Vec3::Unit(v.across);
-    pv.b = Vec3::Unit(v.up);
-    pv.X = X;
-    pv.Y = Y;
-    pv.px_per_mm = scale;
-    pv.lo[0] = c0 - span / 2;
-    pv.lo[1] = c1 - span / 2;
-    pv.hi[0] = c0 + span / 2;
-    pv.hi[1] = c1 + span / 2;
-    g += path_elements(
-        vm_path_mm(path.vm_kind,
-                   Vec3(path.pivot_mm[0], path.pivot_mm[1], path.pivot_mm[2]),
-                   path.length_mm)
-            .primitives,
-        pv, "ff-path-" + v.tag,
-        attr("stroke", "#1f77b4") + attr("stroke-width", "1.5"));
-  }
+  g += path_elements(vm_path_of(path).primitives,
+                     square_view(Vec3::Unit(v.across), Vec3::Unit(v.up), X, Y,
+                                 scale, c0, c1, span),
+                     "ff-path-" + v.tag,
+                     attr("stroke", "#1f77b4") + attr("stroke-width", "1.5"));
   // the trajectory, thinned to about 1500 points
   std::string pts;
   const std::size_t k = std::max<std::size_t>(1, s.size() / 1500);
@@ -159,15 +145,17 @@ std::string panel(const std::vector<ForceSample>& s,
 
 }  // namespace
 
+VmPath vm_path_of(const ForceFieldPath& path) {
+  if (!(path.length_mm > 0.0)) return {};
+  return vm_path_mm(path.vm_kind,
+                    Vec3(path.pivot_mm[0], path.pivot_mm[1], path.pivot_mm[2]),
+                    path.length_mm);
+}
+
 std::string force_field_svg(const std::vector<ForceSample>& samples,
                             const ForceFieldPath& path, std::size_t arrows) {
   // a planar path (the circle, the line): one view, its plane
-  const bool plane =
-      path.length_mm > 0.0 &&
-      vm_path_mm(path.vm_kind,
-                 Vec3(path.pivot_mm[0], path.pivot_mm[1], path.pivot_mm[2]),
-                 path.length_mm)
-          .planar;
+  const bool plane = vm_path_of(path).planar;
   std::vector<View> views;
   if (plane) {
     views = {{"xy", 0, 1}};

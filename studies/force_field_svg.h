@@ -23,6 +23,8 @@
 #include <string>
 #include <vector>
 
+#include "studies/path_svg.h"
+
 namespace vmh::studies {
 
 // one trace row's wrist centre and commanded force (device frame)
@@ -38,6 +40,11 @@ struct ForceFieldPath {
   std::array<double, 3> pivot_mm{};
   double length_mm = 0.0;  // the VM's length L
 };
+
+// The VM's path of `path` as the figures draw it (studies/path_svg.h);
+// empty where length_mm is not > 0. Throws std::runtime_error for a kind
+// not registered.
+VmPath vm_path_of(const ForceFieldPath& path);
 
 // arrows drawn by default
 inline constexpr std::size_t kForceFieldArrows = 72;

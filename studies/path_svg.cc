@@ -14,6 +14,23 @@ namespace vmh::studies {
 using output::svg::attr;
 using output::svg::px;
 
+PathView square_view(const Vec3& a, const Vec3& b,
+                     std::function<double(double)> X,
+                     std::function<double(double)> Y, double px_per_mm,
+                     double c0, double c1, double span) {
+  PathView v;
+  v.a = a;
+  v.b = b;
+  v.X = std::move(X);
+  v.Y = std::move(Y);
+  v.px_per_mm = px_per_mm;
+  v.lo[0] = c0 - span / 2;
+  v.lo[1] = c1 - span / 2;
+  v.hi[0] = c0 + span / 2;
+  v.hi[1] = c1 + span / 2;
+  return v;
+}
+
 std::string path_elements(const std::vector<PathPrimitive>& path,
                           const PathView& v, const std::string& id,
                           const std::string& style) {

@@ -26,6 +26,12 @@ struct PathView {
   double hi[2] = {1.0, 1.0};
 };
 
+// A square view `span` mm wide centred on (c0, c1), view coordinates
+PathView square_view(const Vec3& a, const Vec3& b,
+                     std::function<double(double)> X,
+                     std::function<double(double)> Y, double px_per_mm,
+                     double c0, double c1, double span);
+
 // The elements: a circle or a sphere's outline as a circle (a circle is
 // one only in its own plane's view, where the figures draw it); a line as a
 // line across the frame (a dot where it is seen end-on); a plane seen

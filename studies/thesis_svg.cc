@@ -189,22 +189,10 @@ std::string plane_plot(const std::vector<ThesisSample>& s, const ForceFieldPath&
        attr("transform", "rotate(-90 " + px(left - 40) + " " + px(top + kPlane_px / 2) + ")") +
        " text-anchor=\"middle\">y (mm)</text>\n";
   // the path as the mechanism draws it (studies/path_svg.h), in x-y
-  if (path.length_mm > 0.0) {
-    PathView pv;
-    pv.X = X;
-    pv.Y = Y;
-    pv.px_per_mm = sc;
-    pv.lo[0] = c0 - span / 2;
-    pv.lo[1] = c1 - span / 2;
-    pv.hi[0] = c0 + span / 2;
-    pv.hi[1] = c1 + span / 2;
-    g += path_elements(
-        vm_path_mm(path.vm_kind,
-                   Vec3(path.pivot_mm[0], path.pivot_mm[1], path.pivot_mm[2]),
-                   path.length_mm)
-            .primitives,
-        pv, "", attr("stroke", "#6fa8dc") + attr("stroke-width", "2"));
-  }
+  g += path_elements(vm_path_of(path).primitives,
+                     square_view(Vec3::UnitX(), Vec3::UnitY(), X, Y, sc, c0, c1,
+                                 span),
+                     "", attr("stroke", "#6fa8dc") + attr("stroke-width", "2"));
   // the trajectory in 200 pieces, each in the colour of its time
   const double t0 = s.front().t_s, t1 = std::max(s.back().t_s, t0 + 1e-9);
   const std::size_t pieces = 200;
@@ -313,12 +301,7 @@ std::string thesis_svg(const std::vector<ThesisSample>& samples,
     return svg + "<text x=\"10\" y=\"30\">thesis figures: fewer than two rows</text>\n</svg>\n";
   }
   const bool bands = static_cast<int>(samples.size()) > columns;
-  const bool planar =
-      path.length_mm > 0.0 &&
-      vm_path_mm(path.vm_kind,
-                 Vec3(path.pivot_mm[0], path.pivot_mm[1], path.pivot_mm[2]),
-                 path.length_mm)
-          .planar;
+  const bool planar = vm_path_of(path).planar;
   svg += "<text x=\"10\" y=\"18\" font-size=\"13\">" +
          escape("The VM's joint against time, theta_V (red) and theta_R (green), and "
                 "the RM wrist centre in the mechanism's plane coloured by time") +
