@@ -79,8 +79,9 @@ TEST(LineVm, ForceIsTheSpringToTheLineAloneWhateverTheStylus) {
 // The circle of radius rho centred at origin - rho x is, at the origin, the
 // line: same point, tangent and link. Its force differs from the line's by
 // its bending term, f_t = K_o e_o rho / (rho^2 + 1) along the tangent (the
-// weights one, mm); its curvature moves the nearest point only by
-// O(offset^2 / rho^2) here, the RM being off the common tangent point.
+// weights one, mm). The RM stands on the circle's radius through the common
+// point, so both nearest points are that point and the position parts agree:
+// the gap is the bending term alone.
 TEST(LineVm, IsTheCirclesLimitAsTheRadiusGrows) {
   int tried = 0;
   for (const Joints& q : poses()) {
