@@ -10,9 +10,9 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_params.h"
+#include "output/number_text.h"
 #include "output/output_file.h"
 #include "output/svg_chart.h"
-#include "bringup/compare_text.h"
 #include "bringup/response_sim.h"
 #include "sim/case_catalogue.h"
 
@@ -24,7 +24,7 @@ const double kNan = std::nan("");
 
 // three significant digits unless asked for more
 std::string force_fmt(double v, int digits = 3) {
-  return detail::significant(v, digits);
+  return output::significant(v, digits);
 }
 
 // The recording's rows from the sample before the pulse to its settling:

@@ -13,16 +13,16 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_params.h"
+#include "output/number_text.h"
 #include "output/output_file.h"
 #include "output/svg_chart.h"
-#include "bringup/compare_text.h"
 #include "sim/case_catalogue.h"
 
 namespace vmh::bringup {
 namespace {
 
 std::string mapping_fmt(double v, int digits = 3) {
-  return detail::significant(v, digits);
+  return output::significant(v, digits);
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 #include "output/output_file.h"
 #include "output/svg_chart.h"
 #include "sim/case.h"
-#include "bringup/compare_text.h"
+#include "output/number_text.h"
 #include "sim/closed_loop.h"
 
 namespace vmh::bringup {
@@ -17,7 +17,7 @@ namespace {
 
 // four significant digits unless asked otherwise
 std::string replay_fmt(double v, int digits = 4) {
-  return detail::significant(v, digits);
+  return output::significant(v, digits);
 }
 
 bool text_is(const Recording& r, const char* column, std::size_t row,

@@ -27,12 +27,6 @@ void LineVm::jacobian(const VmAngles&, VmJacobian* J) const {
   J->block<3, 1>(3, 0).setZero();
 }
 
-void LineVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
-                           VmJacobian* J) const {
-  *pose = this->pose(theta);
-  jacobian(theta, J);
-}
-
 bool LineVm::nearest(const RmPose& rm, VmAngles* theta) const {
   (*theta)[0] = direction().dot(rm.p - mount_.origin);
   return true;

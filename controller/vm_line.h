@@ -34,8 +34,6 @@ class LineVm final : public VirtualMechanism {
   VmPose pose(const VmAngles& theta) const override;
   void jacobian(const VmAngles& theta, VmJacobian* J) const override;
   Vec3 position(const VmAngles& theta) const override;
-  void pose_jacobian(const VmAngles& theta, VmPose* pose,
-                     VmJacobian* J) const override;
   // the foot of the perpendicular from the RM; always defined
   bool nearest(const RmPose& rm, VmAngles* theta) const override;
   bool nearest_minimises_distance() const override { return true; }

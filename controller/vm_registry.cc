@@ -1,6 +1,5 @@
 #include "controller/vm_registry.h"
 
-#include <cstring>
 #include <stdexcept>
 
 #include "controller/vm_circle.h"
@@ -74,13 +73,10 @@ const char* vm_kind_name(VmKind kind) {
 }
 
 bool parse_vm_kind(const char* text, VmKind* kind) {
-  for (const VmDescriptor& d : vm_registry()) {
-    if (std::strcmp(text, d.name) == 0) {
-      *kind = d.kind;
-      return true;
-    }
-  }
-  return false;
+  const VmDescriptor* d = find_vm(text);
+  if (d == nullptr) return false;
+  *kind = d->kind;
+  return true;
 }
 
 std::unique_ptr<VirtualMechanism> make_vm(VmKind kind, const VmMount& mount,

@@ -15,8 +15,6 @@ namespace vmh::studies {
 using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
-using constants::kPi;
-
 std::string vec_text(const Vec3& v) {
   char buf[96];
   std::snprintf(buf, sizeof buf, "%.6g,%.6g,%.6g", v.x(), v.y(), v.z());

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "controller/types.h"
+#include "output/number_text.h"
 #include "output/parallel.h"
 
 namespace vmh::studies {
@@ -20,13 +21,6 @@ using namespace vmh::sim;  // NOLINT(build/namespaces)
 namespace {
 
 using constants::kPi;
-
-std::string number_text(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
 
 }  // namespace
 
@@ -131,7 +125,7 @@ WallRun SliderWall::run(double k_N_per_m, int ticks,
     if (d->warning[i].number > 0) {
       throw std::runtime_error(
           "stability study: MuJoCo warning " + std::to_string(i) +
-          " during a run at K = " + number_text(k_N_per_m) + " N/m");
+          " during a run at K = " + output::significant(k_N_per_m, 10) + " N/m");
     }
   }
   if (x_per_tick != nullptr) *x_per_tick = xs;

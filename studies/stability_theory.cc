@@ -7,6 +7,7 @@
 #include <string>
 
 #include "controller/types.h"
+#include "output/number_text.h"
 
 namespace vmh::studies {
 // the testbed's types (sim/) by their own names in this file
@@ -15,12 +16,8 @@ namespace {
 
 using constants::kPi;
 
-std::string str(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
+// ten significant digits, for the messages
+std::string str(double v) { return output::significant(v, 10); }
 
 // "--option: what (got v)"
 [[noreturn]] void bad(const std::string& option, const std::string& what,
