@@ -47,9 +47,6 @@ HandScript::HandScript(const CaseParams& c, const VmParams& vm)
                    vm_kind_name(vm.kind) +
                    "'s normal; the start pose on the path is undefined");
   }
-  r0_ = start_.outward;
-  t0_ = start_.tangent;
-  p0_ = start_.p;
   axis0_ = start_.axis;
   // an explicit stylus axis, for poses the direction alone cannot give (the
   // stylus along the forearm, or turned away from the link)
@@ -134,7 +131,7 @@ int HandScript::segment_at(double t_s) const {
 
 ScriptPose HandScript::raw(int segment, double t_s) const {
   ScriptPose pose;
-  pose.p_mm = p0_;
+  pose.p_mm = start_.p;
   pose.axis = axis0_;
   const Shape shape = shapes_[static_cast<std::size_t>(segment)];
   // misalignment turns the stylus toward the tangent: for the circle and
@@ -142,7 +139,7 @@ ScriptPose HandScript::raw(int segment, double t_s) const {
   // path); the second on-path hold tilts it about the mechanism's tilt_b
   // (the planar ones: the other way about the normal; the sphere: about
   // the tangent, its polar angle)
-  const Vec3 m = r0_.cross(t0_);
+  const Vec3 m = start_.outward.cross(start_.tangent);
   // the pivot and spin scripts: two full swings over the segment, starting
   // where the previous segment ended
   auto two_swings = [&]() {
@@ -157,21 +154,21 @@ ScriptPose HandScript::raw(int segment, double t_s) const {
       pose.p_mm = pivot_;
       break;
     case Shape::kThroughPivot:
-      pose.p_mm = pivot_ + length_mm_ * two_swings() * r0_;
+      pose.p_mm = pivot_ + length_mm_ * two_swings() * start_.outward;
       break;
     case Shape::kSpin:
       pose.axis = Eigen::AngleAxisd(misalign_rad_ * two_swings(), n_unit_) *
                   axis0_;
       break;
     case Shape::kOffOut:
-      pose.p_mm = p0_ + off_mm_ * r0_;
+      pose.p_mm = start_.p + off_mm_ * start_.outward;
       break;
     case Shape::kOffOutMisaligned:
-      pose.p_mm = p0_ + off_mm_ * r0_;
+      pose.p_mm = start_.p + off_mm_ * start_.outward;
       pose.axis = rotate(axis0_, m, misalign_rad_);
       break;
     case Shape::kOffIn:
-      pose.p_mm = p0_ - off_mm_ * r0_;
+      pose.p_mm = start_.p - off_mm_ * start_.outward;
       break;
     case Shape::kOnMisalignedA:
       pose.axis = rotate(axis0_, m, misalign_rad_);

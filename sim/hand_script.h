@@ -55,9 +55,9 @@ class HandScript {
   // the geometry the script is built on: start point on the path, the
   // outward direction there, the tangent along which misalignment and the
   // sweep move, the normal of the sweep plane (all device frame)
-  const Vec3& start_mm() const { return p0_; }
-  const Vec3& outward() const { return r0_; }
-  const Vec3& tangent() const { return t0_; }
+  const Vec3& start_mm() const { return start_.p; }
+  const Vec3& outward() const { return start_.outward; }
+  const Vec3& tangent() const { return start_.tangent; }
 
  private:
   // what a segment does with the pose; named by ScriptSegment::name
@@ -78,7 +78,7 @@ class HandScript {
   // the mechanism in mm, for its path_start and along_path hooks
   std::shared_ptr<const VirtualMechanism> vm_;
   PathStart start_;
-  Vec3 pivot_, r0_, t0_, p0_, axis0_;
+  Vec3 pivot_, axis0_;  // axis0_: start_.axis, or the case's script_axis
   Vec3 n_unit_;  // the pivot frame's z, for the spin's rotation
   double length_mm_, off_mm_, misalign_rad_, sweep_mm_, sweep_rad_;
   double blend_s_ = 0.3;
