@@ -14,7 +14,7 @@
 #include "output/output_file.h"
 #include "output/svg_chart.h"
 #include "bringup/response_sim.h"
-#include "sim/case_catalogue.h"
+#include "sim/cases/case_catalogue.h"
 
 namespace vmh::bringup {
 namespace {

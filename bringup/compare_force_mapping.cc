@@ -16,7 +16,7 @@
 #include "output/number_text.h"
 #include "output/output_file.h"
 #include "output/svg_chart.h"
-#include "sim/case_catalogue.h"
+#include "sim/cases/case_catalogue.h"
 
 namespace vmh::bringup {
 namespace {

@@ -8,7 +8,7 @@
 #include "controller/controller.h"
 #include "output/output_file.h"
 #include "output/svg_chart.h"
-#include "sim/case.h"
+#include "sim/cases/case.h"
 #include "output/number_text.h"
 #include "sim/closed_loop.h"
 

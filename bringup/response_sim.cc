@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "controller/device_frame.h"
-#include "sim/case.h"
+#include "sim/cases/case.h"
 #include "sim/closed_loop.h"
 #include "sim/emulator_hand.h"
 #include "sim/mujoco_util.h"

@@ -11,7 +11,7 @@
 // code 1 and one line on stderr.
 //
 // The controller's options (--vm, --kpos, --kv, --weights, ...) are not
-// defined here: each is a parameter of the case table (sim/case_params.h,
+// defined here: each is a parameter of the case table (sim/cases/case_params.h,
 // docs/parameters.md) with the same name, meaning, default and checks as the
 // scene's <custom> field, and both build ControllerParams with
 // sim::controller_params. --kv is K_v on the position rows only (as a
@@ -34,13 +34,13 @@
 #include "runtime/json_util.h"
 #include "controller/controller.h"
 #include "controller/device_frame.h"
-#include "sim/case_params.h"
+#include "sim/cases/case_params.h"
 
 namespace vmh::cli {
 
 namespace {
 
-// The controller's options are the table's (sim/case_params.h): one CLI
+// The controller's options are the table's (sim/cases/case_params.h): one CLI
 // option per parameter with a ctl_option, its value as text, checked by the
 // same loader as a scene's. Only what is not a parameter is ctl's own.
 struct CtlOptions {

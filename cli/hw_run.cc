@@ -31,9 +31,9 @@
 #include "device/stop_signal.h"
 #include "runtime/stop.h"
 #include "runtime/meta.h"
-#include "sim/scene_fields.h"
+#include "sim/cases/scene_fields.h"
 #ifdef VMH_HAVE_SIM
-#include "sim/case_catalogue.h"
+#include "sim/cases/case_catalogue.h"
 #include "studies/hw_run.h"
 #endif
 

@@ -34,7 +34,7 @@
 #include "output/svg_chart.h"
 #include "bringup/identify.h"
 #include "bringup/recording.h"
-#include "sim/case_catalogue.h"
+#include "sim/cases/case_catalogue.h"
 
 namespace vmh::cli {
 namespace {

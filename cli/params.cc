@@ -1,14 +1,14 @@
 // `vmhaptics params`: every parameter of a case (the scene's <custom> name,
 // which is also the `--set` name, the `ctl` option, type, unit, default,
 // range and meaning) as Markdown on stdout, made from the one table in
-// sim/case_params.cc. docs/parameters.md is this output, verbatim
+// sim/cases/case_params.cc. docs/parameters.md is this output, verbatim
 // (tests/cli/ctl_test.cc checks it):
 //   build/vmhaptics params > docs/parameters.md
 #include "cli/params.h"
 
 #include <iostream>
 
-#include "sim/case_params.h"
+#include "sim/cases/case_params.h"
 
 namespace vmh::cli {
 

@@ -1,4 +1,4 @@
-// The `params` verb: the table of a case's parameters (sim/case_params.h).
+// The `params` verb: the table of a case's parameters (sim/cases/case_params.h).
 #ifndef VMHAPTICS_CLI_PARAMS_H_
 #define VMHAPTICS_CLI_PARAMS_H_
 

@@ -31,7 +31,7 @@
 #include "runtime/stop.h"
 #include "studies/report_job.h"
 #ifdef VMH_HAVE_VIZ
-#include "sim/case.h"
+#include "sim/cases/case.h"
 #include "viz/render.h"
 #endif
 

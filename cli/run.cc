@@ -26,7 +26,7 @@
 #include "device/stop_signal.h"
 #include "output/output_file.h"
 #include "output/progress.h"
-#include "sim/case_params.h"
+#include "sim/cases/case_params.h"
 #include "studies/run_case.h"
 
 namespace vmh::cli {

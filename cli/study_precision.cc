@@ -24,7 +24,7 @@
 #include "cli/study_files.h"
 #include "device/stop_signal.h"
 #include "output/progress.h"
-#include "sim/case.h"
+#include "sim/cases/case.h"
 #include "sim/mujoco_util.h"
 #include "studies/precision_study.h"
 

@@ -6,7 +6,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
-#include "sim/case_params_detail.h"
+#include "sim/cases/case_params_detail.h"
 
 namespace vmh::sim {
 namespace {

@@ -24,7 +24,7 @@
 //
 // The physics is a Plant (sim/plant.h): MuJoCo's model and data, stepped n
 // times per tick, with the passivity observer's energies, MuJoCo's warnings
-// and the first bad state. The case (sim/case.h) is the immutable part:
+// and the first bad state. The case (sim/cases/case.h) is the immutable part:
 // parameters, script, path. ClosedLoop is the servo chain over the plant.
 // Each loop's hand is registered for its own mjData, so loops in different
 // threads do not disturb each other.
@@ -43,8 +43,8 @@
 #include "device/reading_guard.h"
 #include "device/servo_chain.h"
 #include "device/tick_record.h"
-#include "sim/case.h"
-#include "sim/case_config.h"
+#include "sim/cases/case.h"
+#include "sim/cases/case_config.h"
 #include "sim/fault_injector.h"
 #include "sim/omni_model_edit.h"
 #include "sim/plant.h"
@@ -79,7 +79,7 @@ class ClosedLoop {
   // scene once. `scene_path` names the scene in messages.
   ClosedLoop(const std::string& scene_path, const mjModel& compiled,
              const std::vector<std::string>& overrides);
-  // The loop of a case already read (sim/case.h), its scene compiled again
+  // The loop of a case already read (sim/cases/case.h), its scene compiled again
   // from the case's file (`model_hook` applied when set): a run of a case
   // changed after it was read (Case::with_gains_scaled).
   explicit ClosedLoop(const Case& c, const ModelHook& model_hook = {});
@@ -146,7 +146,7 @@ class ClosedLoop {
   // the passivity observer's totals so far, J (see the file comment)
   double energy_motor_J() const { return plant_.energy_motor_J(); }
   double energy_hand_J() const { return plant_.energy_hand_J(); }
-  // the case this loop runs (sim/case.h): parameters, controller, script
+  // the case this loop runs (sim/cases/case.h): parameters, controller, script
   // and timing, read once from the scene
   const Case& the_case() const { return case_; }
   const CaseConfig& config() const { return case_.config(); }

@@ -8,7 +8,7 @@
 #include "hw/firewire/firewire_omni.h"
 #include "hw/firewire/firewire_runtime.h"
 #include "runtime/calibration_store.h"
-#include "sim/case_catalogue.h"
+#include "sim/cases/case_catalogue.h"
 #include "sim/closed_loop.h"
 #include "sim/emulator.h"
 #include "sim/emulator_firewire.h"

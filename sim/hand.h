@@ -32,7 +32,7 @@
 #include <string>
 
 #include "controller/types.h"
-#include "sim/case_config.h"
+#include "sim/cases/case_config.h"
 
 namespace vmh::sim {
 

@@ -20,7 +20,7 @@
 
 #include "controller/controller.h"
 #include "device/tick_record.h"
-#include "sim/case_config.h"
+#include "sim/cases/case_config.h"
 
 namespace vmh::sim {
 

@@ -10,7 +10,7 @@
 
 #include "output/output_file.h"
 #include "sim/mujoco_messages.h"
-#include "sim/scene_fields.h"
+#include "sim/cases/scene_fields.h"
 
 namespace vmh::sim {
 namespace {
@@ -51,7 +51,7 @@ void require_scene_file(const std::string& path) {
 
 // Bounds a scene before MuJoCo reads it (MuJoCo's own reader would block
 // on an included FIFO, and compiles and steps whatever size it is given):
-// the scene and its includes read as sim/scene_fields.h reads them (regular
+// the scene and its includes read as sim/cases/scene_fields.h reads them (regular
 // files, opened without blocking, at most kMaxSceneBytes together, no
 // include cycle), at most kMaxSceneBodies bodies, and every asset file it
 // names that exists a regular file of at most kMaxAssetBytes.

@@ -32,7 +32,7 @@ using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
 using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 
 // What a scene may be before it is compiled (besides
-// sim/scene_fields.h's kMaxSceneBytes for its XML and includes together):
+// sim/cases/scene_fields.h's kMaxSceneBytes for its XML and includes together):
 // the bodies of the scene with its includes, and each asset file (mesh,
 // texture, height field, skin) it names.
 inline constexpr int kMaxSceneBodies = 200;

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <utility>
 
-#include "sim/case_params_detail.h"
+#include "sim/cases/case_params_detail.h"
 
 namespace vmh::sim {
 namespace {

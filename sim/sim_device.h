@@ -16,7 +16,7 @@
 
 #include "device/haptic_device.h"
 #include "controller/omni_params.h"
-#include "sim/case_params.h"  // kMaxDelayTicks
+#include "sim/cases/case_params.h"  // kMaxDelayTicks
 #include "sim/sensor_model.h"
 
 namespace vmh::sim {

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/case.h"
+#include "sim/cases/case.h"
 
 namespace vmh::studies {
 

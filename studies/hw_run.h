@@ -30,7 +30,7 @@ namespace vmh::studies {
 // The case as `hw run` plays it on a simulated device: its scene's
 // parameters, script and claims' settings (the scene loaded once), and the
 // controller scaled for bring-up. (On a real device `hw run` needs only
-// the parameters: sim/scene_fields.h and runtime's
+// the parameters: sim/cases/scene_fields.h and runtime's
 // configure_controller_session.)
 class HwRunCase {
  public:

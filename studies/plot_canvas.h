@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "output/svg_text.h"
-#include "sim/case.h"
+#include "sim/cases/case.h"
 #include "studies/plot_svg.h"
 
 namespace vmh::studies::plot_detail {

@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "device/tick_record.h"
-#include "sim/case.h"
+#include "sim/cases/case.h"
 
 namespace vmh::studies {
 

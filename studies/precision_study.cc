@@ -13,7 +13,7 @@
 
 #include "controller/device_frame.h"
 #include "controller/omni_kinematics.h"
-#include "sim/case.h"
+#include "sim/cases/case.h"
 #include "sim/closed_loop.h"
 #include "sim/mujoco_util.h"
 #include "studies/study_numbers.h"

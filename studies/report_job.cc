@@ -12,7 +12,7 @@
 #include "output/parallel.h"
 #include "output/progress.h"
 #include "runtime/stop.h"
-#include "sim/case_catalogue.h"
+#include "sim/cases/case_catalogue.h"
 #include "studies/extremes_study.h"
 #include "studies/precision_study.h"
 #include "studies/run_case.h"

@@ -19,7 +19,7 @@
 
 #include "output/progress.h"
 #include "sim/mujoco_messages.h"
-#include "sim/case_catalogue.h"
+#include "sim/cases/case_catalogue.h"
 #include "sim/closed_loop.h"
 #include "studies/claims.h"
 #include "studies/summary_json.h"

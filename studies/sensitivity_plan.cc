@@ -12,8 +12,8 @@
 #include <stdexcept>
 
 #include "output/parallel.h"
-#include "sim/case.h"
-#include "sim/case_params.h"
+#include "sim/cases/case.h"
+#include "sim/cases/case_params.h"
 #include "sim/closed_loop.h"
 #include "sim/omni_model_edit.h"
 #include "studies/claims.h"

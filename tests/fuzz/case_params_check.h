@@ -11,8 +11,8 @@
 #include <string>
 
 #include "controller/controller.h"
-#include "sim/case_params.h"
-#include "sim/case_params_detail.h"
+#include "sim/cases/case_params.h"
+#include "sim/cases/case_params_detail.h"
 #include "tests/fuzz/fuzz_check.h"
 
 namespace vmh::fuzz {

@@ -1,4 +1,4 @@
-// libFuzzer harness: the case-parameter loader (sim/case_params.h) as the
+// libFuzzer harness: the case-parameter loader (sim/cases/case_params.h) as the
 // command line drives it.
 //
 // The input is text, one item a line. If the first line is "ctl", the
@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "sim/case_params.h"
+#include "sim/cases/case_params.h"
 #include "tests/fuzz/case_params_check.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data,

@@ -1,5 +1,5 @@
 // libFuzzer harness: a scene file as the MuJoCo-free reader reads it
-// (sim/scene_fields.h: read_scene_fields, what `hw run` on a device and a
+// (sim/cases/scene_fields.h: read_scene_fields, what `hw run` on a device and a
 // device-only build take a case's parameters from).
 //
 // The input is the whole file. The reader must either refuse with a
@@ -15,7 +15,7 @@
 #include <sstream>
 #include <string>
 
-#include "sim/scene_fields.h"
+#include "sim/cases/scene_fields.h"
 #include "tests/fuzz/fuzz_check.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data,

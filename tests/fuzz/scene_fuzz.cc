@@ -1,5 +1,5 @@
 // libFuzzer harness: a scene's <custom> fields as the case loader reads them
-// (sim/case_config.h: CaseConfig::from_model).
+// (sim/cases/case_config.h: CaseConfig::from_model).
 //
 // The input is the body of a scene's <custom> element (<numeric> and <text>
 // fields); the harness puts it into a minimal MJCF scene, has MuJoCo
@@ -17,7 +17,7 @@
 #include <memory>
 #include <string>
 
-#include "sim/case_config.h"
+#include "sim/cases/case_config.h"
 #include "sim/mujoco_messages.h"
 #include "sim/mujoco_util.h"
 #include "tests/fuzz/case_params_check.h"

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/case_config.h"
+#include "sim/cases/case_config.h"
 #include "sim/mujoco_util.h"
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/temp_mjcf.h"

@@ -1,14 +1,14 @@
 // The table of case parameters (case_fields()): every parameter a scene may
 // set, once, with its binding to the typed CaseParams member. The loader that
 // reads values against it is case_params.cc.
-#include "sim/case_params.h"
+#include "sim/cases/case_params.h"
 
 #include <cmath>
 #include <string>
 
 #include "controller/virtual_mechanism.h"
 #include "controller/vm_registry.h"
-#include "sim/case_params_detail.h"
+#include "sim/cases/case_params_detail.h"
 
 namespace vmh::sim {
 namespace {

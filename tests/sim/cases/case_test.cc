@@ -1,10 +1,10 @@
-// sim/case: a case read from a scene as data, without a loop. The expected
+// sim/cases/case: a case read from a scene as data, without a loop. The expected
 // values are the scenes' own (models/cases/case1.xml and case3.xml: Euler
 // at 1 ms, a 20 s thesis script, K_pos 0.5 and 0.6 N/mm) and the case
 // table's documented defaults, written out here; the refusals are the
 // ones a loop over the same scene gave before it read its case through
 // make_case().
-#include "sim/case.h"
+#include "sim/cases/case.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>

@@ -1,5 +1,5 @@
 // A case as data (issue 33): what a scene and its `--set` overrides say a
-// run is, read once and then only read. Its parameters (sim/case_params.h,
+// run is, read once and then only read. Its parameters (sim/cases/case_params.h,
 // overrides applied), its controller's parameters (validated), its hand
 // script, and the timing the run will have: the physics step and
 // integrator, the physics steps per servo tick, the ticks of a run.
@@ -14,8 +14,8 @@
 // Everything a bad scene or override can get wrong is refused here with a
 // SimError naming the file (or `--set`) and the field, before any mjData
 // exists.
-#ifndef VMHAPTICS_SIM_CASE_H_
-#define VMHAPTICS_SIM_CASE_H_
+#ifndef VMHAPTICS_SIM_CASES_CASE_H_
+#define VMHAPTICS_SIM_CASES_CASE_H_
 
 #include <mujoco/mujoco.h>
 
@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "controller/controller.h"
-#include "sim/case_config.h"
+#include "sim/cases/case_config.h"
 #include "sim/hand_script.h"
 #include "sim/mujoco_util.h"
 #include "sim/omni_model_edit.h"
@@ -115,4 +115,4 @@ Case load_case(const std::string& path,
 
 }  // namespace vmh::sim
 
-#endif  // VMHAPTICS_SIM_CASE_H_
+#endif  // VMHAPTICS_SIM_CASES_CASE_H_

@@ -1,6 +1,6 @@
 // A case's parameters read from a scene: the MJCF <custom> fields (the
 // mujoco_mpc habit) with `--set name=value` overrides on top, read once into
-// the typed CaseParams of sim/case_params.h, whose table (case_fields())
+// the typed CaseParams of sim/cases/case_params.h, whose table (case_fields())
 // lists every parameter with its size, default, unit, range and meaning.
 //
 // A scene that carries a <custom> field not in the table, or a known field
@@ -8,15 +8,15 @@
 // `--set` of an unknown name, a value of the wrong size or out of range, or
 // a missing required field is a SimError that names the file (or `--set`)
 // and the field.
-#ifndef VMHAPTICS_SIM_CASE_CONFIG_H_
-#define VMHAPTICS_SIM_CASE_CONFIG_H_
+#ifndef VMHAPTICS_SIM_CASES_CASE_CONFIG_H_
+#define VMHAPTICS_SIM_CASES_CASE_CONFIG_H_
 
 #include <mujoco/mujoco.h>
 
 #include <string>
 #include <vector>
 
-#include "sim/case_params.h"
+#include "sim/cases/case_params.h"
 
 namespace vmh::sim {
 
@@ -31,4 +31,4 @@ struct CaseConfig : CaseParams {
 
 }  // namespace vmh::sim
 
-#endif  // VMHAPTICS_SIM_CASE_CONFIG_H_
+#endif  // VMHAPTICS_SIM_CASES_CASE_CONFIG_H_

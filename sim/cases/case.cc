@@ -1,9 +1,9 @@
-#include "sim/case.h"
+#include "sim/cases/case.h"
 
 #include <cmath>
 #include <stdexcept>
 
-#include "sim/case_params_detail.h"
+#include "sim/cases/case_params_detail.h"
 
 namespace vmh::sim {
 namespace {
@@ -22,7 +22,7 @@ IntegratorSetting integrator_of(const mjModel& m, IntegratorSetting set) {
 
 // The run's physics step and counts, refused as the file comment says.
 // Every count is computed in double, checked against its bound and only
-// then made an integer; the table's ranges (sim/case_fields.cc) have
+// then made an integer; the table's ranges (sim/cases/case_fields.cc) have
 // already refused non-finite values, T outside [1e-5, 1] s and a duration
 // outside (0, 3600] s.
 CaseTiming read_timing(const std::string& path, const mjModel& m,

@@ -2,8 +2,8 @@
 // "case1" into a scene file, for `run`, `hw run`, `view`, the studies and
 // the emulator alike. Cases 1-6 are the thesis's six; case 7 is this
 // project's line slider (the circle's limit, docs/testbed.md).
-#ifndef VMHAPTICS_SIM_CASE_CATALOGUE_H_
-#define VMHAPTICS_SIM_CASE_CATALOGUE_H_
+#ifndef VMHAPTICS_SIM_CASES_CASE_CATALOGUE_H_
+#define VMHAPTICS_SIM_CASES_CASE_CATALOGUE_H_
 
 #include <string>
 #include <vector>
@@ -28,4 +28,4 @@ std::string resolve_scene(const std::string& case_or_path, std::string* name);
 
 }  // namespace vmh::sim
 
-#endif  // VMHAPTICS_SIM_CASE_CATALOGUE_H_
+#endif  // VMHAPTICS_SIM_CASES_CASE_CATALOGUE_H_

@@ -1,7 +1,7 @@
 // Helpers shared by the case-parameter table (case_fields.cc) and its loader
 // (case_params.cc); not part of the public interface.
-#ifndef VMHAPTICS_SIM_CASE_PARAMS_DETAIL_H_
-#define VMHAPTICS_SIM_CASE_PARAMS_DETAIL_H_
+#ifndef VMHAPTICS_SIM_CASES_CASE_PARAMS_DETAIL_H_
+#define VMHAPTICS_SIM_CASES_CASE_PARAMS_DETAIL_H_
 
 #include <string>
 
@@ -15,4 +15,4 @@ std::string format_number(double v);
 
 }  // namespace vmh::sim::detail
 
-#endif  // VMHAPTICS_SIM_CASE_PARAMS_DETAIL_H_
+#endif  // VMHAPTICS_SIM_CASES_CASE_PARAMS_DETAIL_H_

@@ -11,9 +11,9 @@
 // members: nobody looks a parameter up by its name after loading.
 //
 // This header and its source need no MuJoCo: `ctl` uses them without a
-// scene. The reading of a scene's <custom> fields is in sim/case_config.h.
-#ifndef VMHAPTICS_SIM_CASE_PARAMS_H_
-#define VMHAPTICS_SIM_CASE_PARAMS_H_
+// scene. The reading of a scene's <custom> fields is in sim/cases/case_config.h.
+#ifndef VMHAPTICS_SIM_CASES_CASE_PARAMS_H_
+#define VMHAPTICS_SIM_CASES_CASE_PARAMS_H_
 
 #include <cstddef>
 #include <cstdint>
@@ -251,7 +251,7 @@ struct CustomField {
 };
 
 // A scene's case parameters from its <custom> fields (read by MuJoCo,
-// sim/case_config.h, or without it, sim/scene_fields.h), with `overrides`
+// sim/cases/case_config.h, or without it, sim/cases/scene_fields.h), with `overrides`
 // ("name=value", --set) on top. Every field must be one the table knows,
 // under its kind's tag: a number written as <text> (or a word as
 // <numeric>) would otherwise be skipped and its default used without a
@@ -281,4 +281,4 @@ std::string parameters_markdown();
 
 }  // namespace vmh::sim
 
-#endif  // VMHAPTICS_SIM_CASE_PARAMS_H_
+#endif  // VMHAPTICS_SIM_CASES_CASE_PARAMS_H_

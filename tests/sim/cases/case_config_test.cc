@@ -1,4 +1,4 @@
-// sim/case_config: a case's parameters from the scene's <custom> fields,
+// sim/cases/case_config: a case's parameters from the scene's <custom> fields,
 // defaults where the scene is silent, `--set name=value` on top, and
 // setup-time errors that name the file and the field.
 //
@@ -7,7 +7,7 @@
 // loads a case. Expected values are the documented ones (docs/cli.md, "Case
 // parameters"; docs/testbed.md), written out here, not read from the field
 // table the loader uses.
-#include "sim/case_config.h"
+#include "sim/cases/case_config.h"
 
 #include <gtest/gtest.h>
 

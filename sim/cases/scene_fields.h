@@ -3,7 +3,7 @@
 // device (VMH_BUILD_SIM=OFF) can run a case's controller (`hw run
 // case1 --device firewire`), and every build reads a real device's
 // parameters the same way. The simulated loop reads the same fields through
-// MuJoCo (sim/case_config.h); tests/sim/scene_fields_test.cc checks that
+// MuJoCo (sim/cases/case_config.h); tests/sim/cases/scene_fields_test.cc checks that
 // the two agree on every scene of models/ and the tests.
 //
 // What it reads, as MuJoCo 2.2.2 does:
@@ -24,14 +24,14 @@
 // opened, and opened without blocking), at most kMaxSceneBytes for the
 // scene and its includes together, includes nested at most 16 deep and
 // never in a cycle.
-#ifndef VMHAPTICS_SIM_SCENE_FIELDS_H_
-#define VMHAPTICS_SIM_SCENE_FIELDS_H_
+#ifndef VMHAPTICS_SIM_CASES_SCENE_FIELDS_H_
+#define VMHAPTICS_SIM_CASES_SCENE_FIELDS_H_
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "sim/case_params.h"
+#include "sim/cases/case_params.h"
 
 namespace vmh::sim {
 
@@ -63,4 +63,4 @@ CaseParams load_scene_params(const std::string& scene_path,
 
 }  // namespace vmh::sim
 
-#endif  // VMHAPTICS_SIM_SCENE_FIELDS_H_
+#endif  // VMHAPTICS_SIM_CASES_SCENE_FIELDS_H_

@@ -1,4 +1,4 @@
-#include "sim/case_params.h"
+#include "sim/cases/case_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "controller/virtual_mechanism.h"
-#include "sim/case_params_detail.h"
+#include "sim/cases/case_params_detail.h"
 
 namespace vmh::sim {
 

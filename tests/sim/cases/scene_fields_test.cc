@@ -1,9 +1,9 @@
-// The MuJoCo-free reader of a scene's <custom> fields (sim/scene_fields.h)
+// The MuJoCo-free reader of a scene's <custom> fields (sim/cases/scene_fields.h)
 // against MuJoCo's own compiler (mj_loadXML) on every scene of models/ and
 // of the tests: the same fields, kinds and values, and the same case
 // parameters; and the reader's refusals, each naming the file and what was
 // wrong.
-#include "sim/scene_fields.h"
+#include "sim/cases/scene_fields.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -12,7 +12,7 @@
 #include <map>
 #include <sstream>
 
-#include "sim/case_config.h"
+#include "sim/cases/case_config.h"
 #include "sim/mujoco_util.h"
 #include "tests/support/temp_mjcf.h"
 

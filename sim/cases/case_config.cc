@@ -1,4 +1,4 @@
-#include "sim/case_config.h"
+#include "sim/cases/case_config.h"
 
 #include <sstream>
 #include <vector>

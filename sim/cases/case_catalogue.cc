@@ -1,4 +1,4 @@
-#include "sim/case_catalogue.h"
+#include "sim/cases/case_catalogue.h"
 
 #include <cstdlib>
 #include <filesystem>

@@ -1,4 +1,4 @@
-#include "sim/scene_fields.h"
+#include "sim/cases/scene_fields.h"
 
 #include <sys/stat.h>
 
