@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "sim/closed_loop.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 #include "viz/gl_context.h"
 #include "viz/overlay.h"
 #include "viz/png.h"

@@ -32,7 +32,7 @@
 // threads, writing nothing; one iteration is one `run --all`.
 //
 // BM_HwRunLockstep (case 1..6): `hw run --device emulator caseN` in
-// lockstep, as studies::HwRunCase runs it (the emulator opened, the
+// lockstep, as thesis::HwRunCase runs it (the emulator opened, the
 // session through the runtime's loop and safety layer, the claims judged),
 // writing nothing; one iteration is the case's 20 s. realtime_x is
 // simulated seconds per wall second: above 1 is faster than real time.
@@ -48,8 +48,8 @@
 #include "runtime/session.h"
 #include "sim/closed_loop.h"
 #include "sim/emulator_backend.h"
-#include "studies/hw_run.h"
-#include "studies/run_case.h"
+#include "thesis/hw_run.h"
+#include "thesis/run_case.h"
 
 namespace vmh::sim {
 namespace {
@@ -206,13 +206,13 @@ void BM_ClosedLoopTick(benchmark::State& state) {
 void BM_RunAll(benchmark::State& state) {
   int claims_failed = 0;
   for (auto _ : state) {
-    std::vector<studies::CaseJob> jobs;
+    std::vector<thesis::CaseJob> jobs;
     for (const sim::CaseEntry& c : sim::case_catalogue()) {
-      jobs.push_back(studies::CaseJob{c.name, case_scene(static_cast<int>(
-                                         jobs.size() + 1)), {}, {}, false, false});
+      const std::string scene = case_scene(static_cast<int>(jobs.size() + 1));
+      jobs.push_back(thesis::CaseJob{c.name, scene, {}, {}, false, false});
     }
-    studies::run_cases(&jobs, {}, "", 2);
-    for (const studies::CaseJob& j : jobs) {
+    thesis::run_cases(&jobs, {}, "", 2);
+    for (const thesis::CaseJob& j : jobs) {
       if (!j.error.empty()) {
         state.SkipWithError(j.error.c_str());
         return;
@@ -231,7 +231,7 @@ void BM_HwRunLockstep(benchmark::State& state) {
   double simulated_s = 0.0;
   int claims_failed = 0;
   for (auto _ : state) {
-    studies::HwRunCase run(scene, {}, "", 1.0);
+    thesis::HwRunCase run(scene, {}, "", 1.0);
     runtime::OpenRequest rq;
     rq.defaults["hand"] = "case";
     rq.load_calibration = false;

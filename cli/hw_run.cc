@@ -3,7 +3,7 @@
 //                  [--model FILE] [--emulator-fault LIST] [--clock C]
 //
 // The scene's controller on a device, through the servo chain and the
-// safety layer (studies/hw_run.h for a simulated device and its claims;
+// safety layer (thesis/hw_run.h for a simulated device and its claims;
 // on a real device the scene's parameters, read without MuJoCo, and the
 // runtime's session; this file parses, calls and prints). DIR/trace.csv has run's columns; DIR/summary.json the session
 // and, on the emulator, the same metrics and thesis claims as `run`
@@ -34,7 +34,7 @@
 #include "sim/cases/scene_fields.h"
 #ifdef VMH_HAVE_SIM
 #include "sim/cases/case_catalogue.h"
-#include "studies/hw_run.h"
+#include "thesis/hw_run.h"
 #endif
 
 namespace vmh::cli {
@@ -133,11 +133,11 @@ void hw_run(const HwRunArgs& a) {
 #ifdef VMH_HAVE_SIM
   // a simulated device: the case with its script and claims, loaded first
   // so that a bad scene is refused before the device opens
-  std::unique_ptr<studies::HwRunCase> run_case;
+  std::unique_ptr<thesis::HwRunCase> run_case;
   if (backend.simulated) {
     try {
-      run_case = std::make_unique<studies::HwRunCase>(scene, sets, model_file,
-                                                      a.gain_scale);
+      run_case = std::make_unique<thesis::HwRunCase>(scene, sets, model_file,
+                                                     a.gain_scale);
     } catch (const sim::SimError& e) {
       throw UsageError(std::string("hw run: ") + e.what());
     }
@@ -165,8 +165,8 @@ void hw_run(const HwRunArgs& a) {
   // behind it (the project's own HD library over the emulator,
   // docs/libhd.md): its claims are judged as the emulator's are
   if (!run_case && dev.truth != nullptr) {
-    run_case = std::make_unique<studies::HwRunCase>(scene, sets, model_file,
-                                                    a.gain_scale);
+    run_case = std::make_unique<thesis::HwRunCase>(scene, sets, model_file,
+                                                   a.gain_scale);
   }
   if (run_case) measured = run_case->run(&dev, so, &r);
 #endif

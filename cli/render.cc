@@ -25,7 +25,7 @@
 #include "runtime/json_util.h"
 #include "runtime/stop.h"
 #include "sim/mujoco_util.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 #include "viz/render.h"
 
 namespace vmh::cli {

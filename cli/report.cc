@@ -3,7 +3,7 @@
 // One self-contained HTML page, DIR/report.html, with the thesis's figures
 // for each of the seven cases, every measured claim, error against run time,
 // the work-precision figure, the stability map and the extreme scenarios
-// (studies/report_html.h). It runs what it needs into DIR (the files `run
+// (thesis/report_html.h). It runs what it needs into DIR (the files `run
 // --all --out DIR` and `study ... --out DIR/study` write) or, with --reuse,
 // takes those already there and runs only what is missing. Prints one JSON
 // object: {report, cases, claims_passed, claims_total, reused, ran, wall_s}.
@@ -49,7 +49,7 @@ namespace fs = std::filesystem;
 // off the path with the stylus misaligned), else the middle of the run.
 // Written to DIR/<case>/render/ and embedded; without a display the page
 // says why instead.
-studies::RenderFn case_renderer(const fs::path& dir) {
+thesis::RenderFn case_renderer(const fs::path& dir) {
   return [dir](const std::string& case_name, const std::string& scene_path,
                std::string* why_not) -> std::optional<std::string> {
     try {
@@ -73,7 +73,7 @@ studies::RenderFn case_renderer(const fs::path& dir) {
       req.height_px = 600;
       req.out_dir = (dir / case_name / "render").string();
       const std::vector<viz::RenderedImage> images = viz::render(req);
-      const std::string png = studies::read_file_text(images.at(0).path);
+      const std::string png = thesis::read_file_text(images.at(0).path);
       if (png.empty()) {
         *why_not = "could not read " + images.at(0).path;
         return std::nullopt;

@@ -6,7 +6,7 @@
 // Prints a table of the error to the path against the run time (or, with
 // --json, one JSON object holding every case's summary), and writes
 // DIR/<case>/trace.csv and DIR/<case>/summary.json when --out is given.
-// Each case's files are written as one set (studies/run_case.h): a reader of
+// Each case's files are written as one set (thesis/run_case.h): a reader of
 // DIR/<case> sees the previous whole set or the new one, never a mix.
 // Exit codes: 0 every run finished and every claim passed; 1 a claim failed
 // or a run failed (a set that could not be written included: it is not
@@ -27,7 +27,7 @@
 #include "output/output_file.h"
 #include "output/progress.h"
 #include "sim/cases/case_params.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 
 namespace vmh::cli {
 namespace {
@@ -42,17 +42,17 @@ struct RunOptions {
   bool json = false;
   bool duration_given = false;
   std::string model;  // a calibrated Omni MJCF; empty: the scene's own
-  std::string sides = "fitted";  // studies/side_runs.h
+  std::string sides = "fitted";  // thesis/side_runs.h
   bool trace_sides = false;
 };
 
-void print_table(const std::vector<studies::CaseResult>& results) {
+void print_table(const std::vector<thesis::CaseResult>& results) {
   std::printf("%-8s %10s %10s %10s %10s %9s %9s %8s  %s\n", "case",
               "sim_s", "wall_s", "rms_mm", "max_mm", "meanF_N", "maxF_N",
               "on_path", "claims");
-  for (const studies::CaseResult& r : results) {
+  for (const thesis::CaseResult& r : results) {
     int pass = 0;
-    for (const studies::Claim& c : r.claims) pass += c.pass ? 1 : 0;
+    for (const thesis::Claim& c : r.claims) pass += c.pass ? 1 : 0;
     char partial[32] = "";
     if (r.partial_claims > 0) {
       std::snprintf(partial, sizeof partial, " (%d partial)", r.partial_claims);
@@ -63,7 +63,7 @@ void print_table(const std::vector<studies::CaseResult>& results) {
                 r.metrics.mean_force_N, r.metrics.max_force_N,
                 100.0 * r.metrics.time_on_path_s / std::max(r.simulated_s, 1e-9),
                 pass, r.claims.size(), partial, r.all_claims_pass ? "" : "  FAIL");
-    for (const studies::Claim& c : r.claims) {
+    for (const thesis::Claim& c : r.claims) {
       std::printf("    %-4s %-36s %10.4g %s %-7.4g %-5s at %5.1f mm off",
                   c.pass ? "ok" : c.partial ? "part" : "FAIL", c.name.c_str(), c.value,
                   c.comparison.c_str(), c.threshold, c.unit.c_str(),
@@ -88,9 +88,9 @@ void run(const RunOptions& o) {
     throw UsageError("--jobs: must be >= 0 (0: one per core), got " +
                      std::to_string(o.jobs));
   }
-  studies::CaseRunOptions run_options;
+  thesis::CaseRunOptions run_options;
   if (o.sides == "full") {
-    run_options.sides = studies::SideMode::kFull;
+    run_options.sides = thesis::SideMode::kFull;
   } else if (o.sides != "fitted") {
     throw UsageError("--sides: 'fitted' or 'full', got '" + o.sides + "'");
   }
@@ -147,9 +147,9 @@ void run(const RunOptions& o) {
       throw UsageError(std::string("run: --out ") + e.what());
     }
   }
-  std::vector<studies::CaseJob> runs;
+  std::vector<thesis::CaseJob> runs;
   for (const auto& [name, scene] : jobs) {
-    runs.push_back(studies::CaseJob{name, scene, {}, {}, false, false});
+    runs.push_back(thesis::CaseJob{name, scene, {}, {}, false, false});
   }
   {
     // SIGINT / SIGTERM only set a flag (device/stop_signal.h); the runs poll
@@ -159,15 +159,15 @@ void run(const RunOptions& o) {
     {
       // a bar on stderr (terminal only) for --all; one case is one item
       output::Progress bar("run", runs.size());
-      studies::run_cases(&runs, sets, o.out, o.jobs, model,
-                         o.all ? bar.part(0) : output::ProgressFn{},
-                         [&signals] { return signals.requested(); },
-                         run_options);
+      thesis::run_cases(
+          &runs, sets, o.out, o.jobs, model,
+          o.all ? bar.part(0) : output::ProgressFn{},
+          [&signals] { return signals.requested(); }, run_options);
     }
     if (signals.requested()) {
       const int signo = signals.signal_number();
       std::string kept;
-      for (const studies::CaseJob& j : runs) {
+      for (const thesis::CaseJob& j : runs) {
         if (j.error.empty() && !o.out.empty()) kept += " " + j.name;
       }
       throw runtime::SignalStop(std::string("interrupted: run stopped by ") +
@@ -178,10 +178,10 @@ void run(const RunOptions& o) {
                        signo);
     }
   }
-  std::vector<studies::CaseResult> results;
+  std::vector<thesis::CaseResult> results;
   std::string errors;  // every failed run, in one line
   bool bad_input = false;
-  for (const studies::CaseJob& j : runs) {
+  for (const thesis::CaseJob& j : runs) {
     if (!j.error.empty()) {
       errors += (errors.empty() ? "run " : "; ") + j.name + ": " + j.error;
       bad_input |= j.bad_input;
@@ -195,7 +195,7 @@ void run(const RunOptions& o) {
 
   if (o.json) {
     nlohmann::json all = nlohmann::json::object();
-    for (const studies::CaseResult& r : results) all[r.name] = r.summary;
+    for (const thesis::CaseResult& r : results) all[r.name] = r.summary;
     std::cout << all.dump(2) << '\n';
   } else {
     print_table(results);
@@ -208,8 +208,8 @@ void run(const RunOptions& o) {
   std::fflush(stdout);
 
   std::string failed;
-  for (const studies::CaseResult& r : results) {
-    for (const studies::Claim& c : r.claims) {
+  for (const thesis::CaseResult& r : results) {
+    for (const thesis::Claim& c : r.claims) {
       if (!c.pass && !c.partial) failed += " " + r.name + ":" + c.name;
     }
   }

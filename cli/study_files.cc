@@ -3,7 +3,7 @@
 #include "cli/args.h"
 #include "device/stop_signal.h"
 #include "sim/mujoco_util.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 
 namespace vmh::cli {
 
@@ -36,7 +36,7 @@ std::vector<double> parse_number_list(const std::string& option,
   return out;
 }
 
-studies::StopFn study_stop() {
+runtime::StopFn study_stop() {
   return [] { return stop_requested(); };
 }
 

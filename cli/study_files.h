@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "runtime/stop.h"
-#include "studies/stop.h"
 
 namespace vmh::cli {
 
@@ -15,17 +14,17 @@ namespace vmh::cli {
 // (device/stop_signal.h) for its whole run and passes study_stop() as its
 // study's should_stop, which the study polls between its runs, in their
 // tick loops and on every thread, and last before it writes its first
-// file. A study stopped so throws studies::Interrupted, with nothing
+// file. A study stopped so throws runtime::Interrupted, with nothing
 // written; run_stoppable() turns that into runtime::SignalStop naming the
 // verb and the first signal ("interrupted: study extremes stopped by
 // SIGINT; nothing written"), which exits 130 / 143 (cli/main.cc).
-studies::StopFn study_stop();
+runtime::StopFn study_stop();
 
 template <typename Body>
 decltype(auto) run_stoppable(const std::string& verb, Body&& body) {
   try {
     return body();
-  } catch (const studies::Interrupted&) {
+  } catch (const runtime::Interrupted&) {
     runtime::throw_if_stopped(verb, "; nothing written");
     throw;  // stopped without a signal: not from study_stop()
   }

@@ -18,7 +18,7 @@
 #include "device/stop_signal.h"
 #include "studies/leanness_study.h"
 #include "sim/mujoco_util.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 
 namespace vmh::cli {
 namespace {

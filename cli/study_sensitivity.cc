@@ -31,7 +31,7 @@
 #include "output/parallel.h"
 #include "output/progress.h"
 #include "sim/mujoco_util.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 #include "studies/sensitivity_study.h"
 
 namespace vmh::cli {

@@ -34,7 +34,7 @@
 #include "output/output_file.h"
 #include "output/parallel.h"
 #include "output/progress.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 #include "studies/stability_study.h"
 
 namespace vmh::cli {

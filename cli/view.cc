@@ -22,7 +22,7 @@
 #include "controller/device_frame.h"
 #include "sim/closed_loop.h"
 #include "sim/served_emulator.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 #include "viz/viewer.h"
 
 namespace vmh::cli {

@@ -124,7 +124,7 @@ struct PathStart {
 
 // What the law acts on at a static pose, worked out by a route apart from
 // the servo tick's (each VM's prediction hook, controller/vm_registry.h,
-// used by studies/law_prediction.h): from the wrist centre and the stylus
+// used by thesis/law_prediction.h): from the wrist centre and the stylus
 // axis alone, in closed form, the nearest point of the path x_v, the handle
 // turned onto the stylus x_r, the orientation error (the thesis's or the
 // geometric, device frame, rad) and J_V at x_v built from the geometry, not

@@ -130,7 +130,7 @@ class ClosedLoop {
   // script_time_s(), no later than duration_s), the physics' state as it
   // is: what a run does once the plant has settled in a hold whose target
   // stands still, to spare simulating the rest of the hold
-  // (studies/side_runs.h). Throws std::invalid_argument out of that range.
+  // (thesis/side_runs.h). Throws std::invalid_argument out of that range.
   void skip_script_to(double t_s);
   // the run's length in ticks at the nominal period; with servo jitter the
   // count differs, so loop until finished()

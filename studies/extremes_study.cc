@@ -14,7 +14,7 @@
 #include "controller/omni_kinematics.h"
 #include "output/output_file.h"
 #include "output/parallel.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 
 namespace vmh::studies {
 // the testbed's types (sim/) by their own names in this file
@@ -73,13 +73,13 @@ void read_limits(const ClosedLoop& loop, ExtremeResult* r) {
 // Ticks the loop until end_s, a row per tick; the wall time and the ticks
 // go in r.
 void run_ticks(ClosedLoop* loop, double end_s, std::vector<TickRecord>* rows,
-               ExtremeResult* r, const StopFn& stop) {
+               ExtremeResult* r, const runtime::StopFn& stop) {
   const mjModel* m = loop->model();
   rows->clear();
   rows->reserve(static_cast<std::size_t>(loop->ticks_per_run()));
   const auto start = std::chrono::steady_clock::now();
   while (loop->time_s() < end_s - 0.5 * m->opt.timestep) {
-    throw_if_stop_asked(stop);
+    runtime::throw_if_stop_asked(stop);
     rows->emplace_back();
     loop->tick(&rows->back());
   }
@@ -313,7 +313,8 @@ std::vector<ExtremeScenario> pick_scenarios(const std::vector<std::string>& only
 }  // namespace
 
 ExtremeResult run_extreme(const ExtremeScenario& s,
-                          std::vector<TickRecord>* trace, const StopFn& stop) {
+                          std::vector<TickRecord>* trace,
+                          const runtime::StopFn& stop) {
   ExtremeResult r;
   r.scenario = s;
   std::string name;
@@ -377,7 +378,7 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
   std::atomic<bool> stopped{false};
   output::parallel_for(table.size(), o.jobs, [&](std::size_t i) {
     // once stopped, the scenarios not begun are skipped
-    if (stopped || stop_asked(o.should_stop)) {
+    if (stopped || runtime::stop_asked(o.should_stop)) {
       stopped = true;
       return;
     }
@@ -386,7 +387,7 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
       result.scenarios[i] = run_extreme(table[i], &rows, o.should_stop);
       result.energy[i] = thin_energy(rows);
       if (series) series->write(table[i].name + ".csv", extreme_series_csv(rows));
-    } catch (const Interrupted&) {
+    } catch (const runtime::Interrupted&) {
       stopped = true;
       return;
     } catch (const std::exception& e) {
@@ -394,14 +395,14 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
     }
     if (o.progress) o.progress(++finished, table.size());
   });
-  if (stopped) throw Interrupted();
+  if (stopped) throw runtime::Interrupted();
   for (const std::string& e : errors) {
     if (!e.empty()) throw SimError(e);
   }
   result.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // the last poll: from here the series' folder and the three files go in
-  throw_if_stop_asked(o.should_stop);
+  runtime::throw_if_stop_asked(o.should_stop);
   if (series) {
     made_here.keep = true;
     series->commit();

@@ -26,7 +26,7 @@
 
 #include "output/svg_chart.h"
 #include "sim/closed_loop.h"
-#include "studies/stop.h"
+#include "runtime/stop.h"
 
 namespace vmh::studies {
 
@@ -165,10 +165,10 @@ struct ExtremeResult {
 
 // Runs one scenario. With `trace` non-null, fills it with every tick's row.
 // Throws SimError on bad input (a bad override, an unreachable start pose),
-// Interrupted when `stop` (if set, polled every tick) says so.
+// runtime::Interrupted when `stop` (if set, polled every tick) says so.
 ExtremeResult run_extreme(const ExtremeScenario& s,
                           std::vector<TickRecord>* trace = nullptr,
-                          const StopFn& stop = {});
+                          const runtime::StopFn& stop = {});
 
 struct ExtremesOptions {
   std::vector<std::string> only;  // scenario names, in this order; empty: all
@@ -180,7 +180,7 @@ struct ExtremesOptions {
   std::function<void(std::size_t, std::size_t)> progress;
   // polled from the workers between scenarios and every tick (studies/
   // stop.h); not set: never stops
-  StopFn should_stop;
+  runtime::StopFn should_stop;
 };
 
 // The passivity observer E(t) of one scenario, thinned for the figure
@@ -205,8 +205,8 @@ struct ExtremesResult {
 // input. The series go into a private folder beside out_dir/extremes as
 // they are made (output::OutputSet) and replace that folder whole at the
 // end, just before the three files: should_stop (polled last before that)
-// throws Interrupted with nothing written and no folder of its own left,
-// and out_dir/extremes then holds only the series of the scenarios run.
+// throws runtime::Interrupted with nothing written and no folder of its own
+// left, and out_dir/extremes then holds only the series of the scenarios run.
 ExtremesResult run_extremes_study(const ExtremesOptions& options);
 
 // ---------------------------------------------------------------- output

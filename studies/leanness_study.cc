@@ -93,7 +93,7 @@ void switch_on(ClosedLoop* loop, unsigned ingredients) {
   loop->reset();
 }
 
-void run_variant(VariantLoop* v, int ticks, const StopFn& stop) {
+void run_variant(VariantLoop* v, int ticks, const runtime::StopFn& stop) {
   ClosedLoop& loop = *v->loop;
   const mjModel* m = loop.model();
   mjData* d = loop.data();
@@ -110,7 +110,7 @@ void run_variant(VariantLoop* v, int ticks, const StopFn& stop) {
   const double cpu0 = thread_cpu_s();
   for (std::size_t k = 0; k < n; ++k) {
     // every 64 ticks: a poll per tick would be timed with the variant
-    if ((k & 63u) == 0) throw_if_stop_asked(stop);
+    if ((k & 63u) == 0) runtime::throw_if_stop_asked(stop);
     loop.tick(&row);
     if (v->viewer) v->viewer->update(m, d);
     v->p_mm[k] =
@@ -256,7 +256,7 @@ VariantResult variant_result(const VariantLoop& v, const VariantLoop& composed,
 // One case: its variants run `repeats` times, interleaved.
 CaseLeanness measure_case(const std::pair<std::string, std::string>& scene,
                           std::vector<VariantLoop>* loops_in, int repeats,
-                          const StopFn& stop) {
+                          const runtime::StopFn& stop) {
   std::vector<VariantLoop>& loops = *loops_in;
   const ClosedLoop& first = *loops.front().loop;
   CaseLeanness cl;
@@ -298,7 +298,7 @@ LeannessResult run_leanness_study(const LeannessOptions& o) {
   // every loop is built (and every scene checked) before the first run
   std::vector<std::vector<VariantLoop>> all;
   for (const auto& scene : o.scenes) {
-    throw_if_stop_asked(o.should_stop);
+    runtime::throw_if_stop_asked(o.should_stop);
     all.push_back(make_loops(scene.second, sets));
   }
   for (std::size_t c = 0; c < o.scenes.size(); ++c) {
@@ -308,7 +308,7 @@ LeannessResult run_leanness_study(const LeannessOptions& o) {
   result.study_wall_time_s =
       std::chrono::duration<double>(Clock::now() - study_start).count();
   // the last poll: from here leanness.csv goes in
-  throw_if_stop_asked(o.should_stop);
+  runtime::throw_if_stop_asked(o.should_stop);
   if (!o.out_dir.empty()) {
     result.files = {output::write_file_in(o.out_dir, "leanness.csv",
                                           leanness_csv(result))};

@@ -35,7 +35,7 @@
 #include <utility>
 #include <vector>
 
-#include "studies/stop.h"
+#include "runtime/stop.h"
 
 namespace vmh::studies {
 
@@ -65,8 +65,8 @@ struct LeannessOptions {
   std::string out_dir;  // where leanness.csv goes; empty: nothing written
   // polled between the cases' loads, before each variant's run and every
   // 64 of its ticks, and last before leanness.csv is written
-  // (studies/stop.h); not set: never stops
-  StopFn should_stop;
+  // (runtime/stop.h); not set: never stops
+  runtime::StopFn should_stop;
 };
 
 struct VariantResult {
@@ -127,8 +127,8 @@ struct LeannessResult {
 };
 
 // Runs the study and, with out_dir, writes out_dir/leanness.csv. Throws
-// SimError on a bad scene or override, before any run; Interrupted when
-// should_stop says so, before anything is written.
+// SimError on a bad scene or override, before any run; runtime::Interrupted
+// when should_stop says so, before anything is written.
 LeannessResult run_leanness_study(const LeannessOptions& options);
 
 // one row per case and variant, units in the column names

@@ -68,7 +68,7 @@ std::vector<std::string> run_overrides(const PrecisionOptions& o,
 // the first one exactly (MuJoCo and the controller are deterministic), else
 // SimError.
 Trajectory run_loop(ClosedLoop* loop, int ticks, double min_timing_s,
-                    int max_repeats, const StopFn& stop) {
+                    int max_repeats, const runtime::StopFn& stop) {
   const OmniParams& omni = loop->controller_params().omni;
   const std::size_t n = static_cast<std::size_t>(ticks);
   Trajectory tr, again;
@@ -93,7 +93,7 @@ Trajectory run_loop(ClosedLoop* loop, int ticks, double min_timing_s,
     const double cpu0 = thread_cpu_s();
     for (std::size_t k = 0; k < n; ++k) {
       // every 64 ticks: a poll per tick would be timed with the rung
-      if ((k & 63u) == 0) throw_if_stop_asked(stop);
+      if ((k & 63u) == 0) runtime::throw_if_stop_asked(stop);
       loop->tick(&row);
       const OmniPose pose = omni_fk(omni, loop->device().true_q_dh());
       t.p_mm[k] = base_to_device_mm(omni, pose.p_base_m);
@@ -450,7 +450,7 @@ PrecisionResult run_precision_study(const PrecisionOptions& o) {
   if (o.progress) o.progress(1, runs);
   // the ladder, one run at a time, so that the timings do not compete
   for (const Setting& s : settings) {
-    throw_if_stop_asked(o.should_stop);
+    runtime::throw_if_stop_asked(o.should_stop);
     r.rows.push_back(run_rung(o, s, ref, r));
     if (o.progress) o.progress(r.rows.size() + 1, runs);
   }
@@ -460,7 +460,7 @@ PrecisionResult run_precision_study(const PrecisionOptions& o) {
   r.study_wall_time_s =
       std::chrono::duration<double>(Clock::now() - study_start).count();
   // the last poll: from here the files go in
-  throw_if_stop_asked(o.should_stop);
+  runtime::throw_if_stop_asked(o.should_stop);
   if (!o.out_dir.empty()) r.files = write_precision_files(r, o.out_dir);
   return r;
 }

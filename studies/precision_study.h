@@ -31,7 +31,7 @@
 #include "output/progress.h"
 #include "output/svg_chart.h"
 #include "studies/modelling_spread.h"
-#include "studies/stop.h"
+#include "runtime/stop.h"
 
 namespace vmh::studies {
 
@@ -70,9 +70,9 @@ struct PrecisionOptions {
   // each rung of the ladder; not set: nothing
   output::ProgressFn progress;
   // polled between the runs and every 64 ticks of each (both references'
-  // threads too), and last before the files are written (studies/stop.h);
+  // threads too), and last before the files are written (runtime/stop.h);
   // not set: never stops
-  StopFn should_stop;
+  runtime::StopFn should_stop;
   // the sensitivity study's spread of the RMS path error, shown beside the
   // errors (precision.svg, the JSON's modelling_spread); not present: none
   ModellingSpread modelling_spread;
@@ -158,7 +158,7 @@ inline constexpr double kFloorFactor = 10.0;
 // Runs the study and, with out_dir, writes its files (write_precision_files).
 // Throws SimError on bad input (a step that does not divide the servo
 // period or is not above the reference step, a bad scene or override, a
-// duration beyond the case's), before any run; Interrupted when
+// duration beyond the case's), before any run; runtime::Interrupted when
 // should_stop says so, before any file is written.
 PrecisionResult run_precision_study(const PrecisionOptions& options);
 

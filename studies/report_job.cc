@@ -15,9 +15,8 @@
 #include "sim/cases/case_catalogue.h"
 #include "studies/extremes_study.h"
 #include "studies/precision_study.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 #include "studies/stability_study.h"
-#include "studies/stop.h"
 
 namespace vmh::studies {
 namespace {
@@ -91,13 +90,13 @@ std::string rj_map_note(const StabilityOptions& so) {
 }
 
 // One of the studies, asked to stop when a signal came (it polls the
-// flag inside its runs and throws Interrupted before writing): the stop
-// named as report's, with what report keeps
+// flag inside its runs and throws runtime::Interrupted before writing): the
+// stop named as report's, with what report keeps
 template <typename F>
 void rj_run_stoppable(F study, const std::string& kept) {
   try {
     study();
-  } catch (const Interrupted&) {
+  } catch (const runtime::Interrupted&) {
     runtime::throw_if_stopped("report", kept);
     throw;
   }
@@ -108,7 +107,7 @@ bool rj_stop() { return stop_requested(); }
 // what is there already (with reuse) and what must run
 struct RjPlan {
   std::vector<std::string> reused, ran;
-  std::vector<CaseJob> cases;
+  std::vector<thesis::CaseJob> cases;
   bool extremes = false, map = false, precision = false;
 };
 
@@ -152,7 +151,7 @@ void rj_run(const ReportJob& job, RjPlan* plan, const fs::path& dir,
   if (!plan->cases.empty()) {
     run_cases(&plan->cases, {}, dir.string(), job.jobs, "", bar.part(p_cases), rj_stop);
     runtime::throw_if_stopped("report", kept);
-    for (const CaseJob& j : plan->cases) {
+    for (const thesis::CaseJob& j : plan->cases) {
       if (!j.error.empty()) throw std::runtime_error("report: " + j.name + ": " + j.error);
     }
   }
@@ -183,10 +182,13 @@ void rj_run(const ReportJob& job, RjPlan* plan, const fs::path& dir,
 }
 
 // the studies' files, as the page shows them
-ReportStudies rj_studies(const fs::path& study_dir, const PrecisionOptions& precision,
-                         const StabilityOptions& map) {
-  auto text = [&](const char* name) { return read_file_text((study_dir / name).string()); };
-  ReportStudies st;
+thesis::ReportStudies rj_studies(const fs::path& study_dir,
+                                 const PrecisionOptions& precision,
+                                 const StabilityOptions& map) {
+  auto text = [&](const char* name) {
+    return thesis::read_file_text((study_dir / name).string());
+  };
+  thesis::ReportStudies st;
   st.precision_case = precision.name;
   st.precision_csv = text("precision.csv");
   st.precision_svg = text("precision.svg");
@@ -233,11 +235,12 @@ ReportOutcome make_report(const ReportJob& job) {
   const StabilityOptions map = rj_map_options(job, study_dir);
   rj_run(job, &plan, dir, precision, map, kept);
 
-  ReportInputs in;
+  thesis::ReportInputs in;
   for (const sim::CaseEntry& c : sim::case_catalogue()) {
     runtime::throw_if_stopped("report", kept);
     try {
-      in.cases.push_back(load_report_case(dir.string(), c.name, job.render));
+      in.cases.push_back(
+          thesis::load_report_case(dir.string(), c.name, job.render));
     } catch (const runtime::SignalStop&) {
       runtime::throw_if_stopped("report", kept);  // named as report's
       throw;
@@ -252,7 +255,7 @@ ReportOutcome make_report(const ReportJob& job) {
   }
   in.studies = rj_studies(study_dir, precision, map);
 
-  ReportHeader& h = in.header;
+  thesis::ReportHeader& h = in.header;
   h.version = job.version;
   h.git_describe = job.git_describe;
   h.generated_utc = job.generated_utc;
@@ -268,7 +271,7 @@ ReportOutcome make_report(const ReportJob& job) {
   // a signal while the page went in: it is whole, and the exit says so
   runtime::throw_if_stopped("report", "; " + out.page + " was already written whole");
 
-  for (const ReportCase& c : in.cases) out.cases.push_back(c.name);
+  for (const thesis::ReportCase& c : in.cases) out.cases.push_back(c.name);
   out.reused = plan.reused;
   out.ran = plan.ran;
   out.tally = tally_claims(in.cases);

@@ -1,6 +1,6 @@
 // The report's job (`vmhaptics report`, cli/report.cc): runs into a folder
 // what the page needs, or with `reuse` takes what is already there, and
-// writes the page, DIR/report.html (studies/report_html.h).
+// writes the page, DIR/report.html (thesis/report_html.h).
 //
 // What it runs into DIR: the six thesis cases as `run --all --out DIR`
 // writes them (DIR/<case>/), and the extreme scenarios, the stability map
@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "studies/report_html.h"
+#include "thesis/report_html.h"
 
 namespace vmh::studies {
 
@@ -36,14 +36,14 @@ struct ReportJob {
   // the page's header: what made it
   std::string command_line, version, git_describe, generated_utc;
   // one picture per case, or why there is none (must be set)
-  RenderFn render;
+  thesis::RenderFn render;
 };
 
 struct ReportOutcome {
   std::string page;                // the page's path
   std::vector<std::string> cases;  // in the page's order
   std::vector<std::string> reused, ran;  // cases' and studies' names
-  ClaimTally tally;
+  thesis::ClaimTally tally;
   double wall_s = 0.0;  // the job, first to last
 };
 

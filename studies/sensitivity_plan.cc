@@ -16,8 +16,8 @@
 #include "sim/cases/case_params.h"
 #include "sim/closed_loop.h"
 #include "sim/omni_model_edit.h"
-#include "studies/claims.h"
-#include "studies/run_case.h"
+#include "thesis/claims.h"
+#include "thesis/run_case.h"
 #include "studies/study_numbers.h"
 
 namespace vmh::studies {

@@ -13,13 +13,13 @@
 #include "sim/cases/case.h"
 #include "sim/closed_loop.h"
 #include "sim/omni_model_edit.h"
-#include "studies/claims.h"
-#include "studies/run_case.h"
+#include "thesis/claims.h"
+#include "thesis/run_case.h"
 
 namespace vmh::studies {
 
 PointResult run_point(const SweepPlan& plan, std::size_t index,
-                      const StopFn& stop) {
+                      const runtime::StopFn& stop) {
   PointResult r;
   r.index = index;
   const SweepPoint& pt = plan.points.at(index);
@@ -40,22 +40,25 @@ PointResult run_point(const SweepPlan& plan, std::size_t index,
     };
     sim::ClosedLoop loop(c.scene, pt.overrides, hook);
     const int thesis_case = loop.config().thesis_case;
-    if (auto ref = reference_params(thesis_case, loop.controller_params())) {
+    if (auto ref =
+            thesis::reference_params(thesis_case, loop.controller_params())) {
       loop.set_reference(*ref);
     }
     std::vector<TickRecord> rows;
     rows.reserve(static_cast<std::size_t>(loop.ticks_per_run()));
     while (!loop.finished()) {
-      throw_if_stop_asked(stop);
+      runtime::throw_if_stop_asked(stop);
       rows.emplace_back();
       loop.tick(&rows.back());
     }
-    r.rms_path_error_mm = run_metrics(rows, loop.the_case()).rms_path_error_mm;
-    for (const Claim& cl : evaluate_claims(thesis_case, rows, loop.the_case())) {
+    r.rms_path_error_mm =
+        thesis::run_metrics(rows, loop.the_case()).rms_path_error_mm;
+    for (const thesis::Claim& cl :
+         thesis::evaluate_claims(thesis_case, rows, loop.the_case())) {
       r.claims.push_back({cl.name, cl.value, cl.threshold, cl.comparison,
                           cl.unit, static_cast<bool>(cl.pass)});
     }
-  } catch (const Interrupted&) {
+  } catch (const runtime::Interrupted&) {
     throw;  // not the point's failure: the sweep stops
   } catch (const std::exception& e) {
     r.error = e.what();
@@ -69,7 +72,7 @@ std::vector<PointResult> run_points(const SweepPlan& plan,
                                     const std::vector<std::size_t>& which,
                                     int jobs,
                                     const output::ProgressFn& progress,
-                                    const StopFn& stop) {
+                                    const runtime::StopFn& stop) {
   std::vector<std::size_t> list = which;
   if (list.empty()) {
     for (std::size_t i = 0; i < plan.points.size(); ++i) list.push_back(i);
@@ -79,19 +82,19 @@ std::vector<PointResult> run_points(const SweepPlan& plan,
   std::atomic<bool> stopped{false};
   output::parallel_for(list.size(), jobs > 0 ? jobs : output::core_count(),
                        [&](std::size_t i) {
-                         if (stopped || stop_asked(stop)) {
+                         if (stopped || runtime::stop_asked(stop)) {
                            stopped = true;
                            return;
                          }
                          try {
                            out[i] = run_point(plan, list[i], stop);
-                         } catch (const Interrupted&) {
+                         } catch (const runtime::Interrupted&) {
                            stopped = true;
                            return;
                          }
                          if (progress) progress(++done, list.size());
                        });
-  if (stopped) throw Interrupted();
+  if (stopped) throw runtime::Interrupted();
   return out;
 }
 

@@ -36,7 +36,7 @@
 #include "output/progress.h"
 #include "output/svg_chart.h"
 #include "sim/mujoco_util.h"
-#include "studies/stop.h"
+#include "runtime/stop.h"
 
 namespace vmh::studies {
 
@@ -155,19 +155,20 @@ struct PointResult {
 
 // Runs one point: the case's closed loop to its end, its claims and RMS
 // path error. A failed run is recorded in `error`; it throws only
-// Interrupted, when `stop` (if set, polled every tick) says so.
+// runtime::Interrupted, when `stop` (if set, polled every tick) says so.
 PointResult run_point(const SweepPlan& plan, std::size_t index,
-                      const StopFn& stop = {});
+                      const runtime::StopFn& stop = {});
 
 // Runs the points `which` (all: empty) on `jobs` threads, in index order.
 // `stop` (if set) is polled from the workers between points and every
 // tick: once it says so, no point starts, those running end at their next
-// tick, and Interrupted is thrown (nothing is written here either way).
+// tick, and runtime::Interrupted is thrown (nothing is written here either
+// way).
 std::vector<PointResult> run_points(const SweepPlan& plan,
                                     const std::vector<std::size_t>& which,
                                     int jobs,
                                     const output::ProgressFn& progress = {},
-                                    const StopFn& stop = {});
+                                    const runtime::StopFn& stop = {});
 
 // The claim's margin: value - threshold for ">=", threshold - value for
 // "<=" (>= 0 where it holds), over |threshold| when that is not 0.

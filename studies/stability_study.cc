@@ -191,11 +191,11 @@ WallRun SliderWall::run(double k_N_per_m, int ticks,
 }
 
 SimKcrit k_crit_simulated(SliderWall& wall, double k_guess_N_per_m,
-                          double rel_tol, const StopFn& stop) {
+                          double rel_tol, const runtime::StopFn& stop) {
   SimKcrit r;
   WallRun at_lo, at_hi;  // the bracket's runs
   auto grows = [&](double k) {
-    throw_if_stop_asked(stop);
+    runtime::throw_if_stop_asked(stop);
     const WallRun run = wall.run(k);
     r.history.push_back(run);
     ++r.runs;
@@ -247,7 +247,7 @@ SimKcrit k_crit_simulated(SliderWall& wall, double k_guess_N_per_m,
 
 StabilityReport study_stability(const std::string& model_path,
                                 const StabilityParams& p, double rel_tol,
-                                const StopFn& stop) {
+                                const runtime::StopFn& stop) {
   const auto t0 = std::chrono::steady_clock::now();
   StabilityReport r;
   r.params = p;
@@ -290,7 +290,7 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
   std::atomic<bool> stopped{false};
   output::parallel_for(points.size(), spec.jobs, [&](std::size_t i) {
     // once stopped, the points not begun are skipped
-    if (stopped || stop_asked(spec.should_stop)) {
+    if (stopped || runtime::stop_asked(spec.should_stop)) {
       stopped = true;
       return;
     }
@@ -308,7 +308,7 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
                                ? pt.k_crit_exact_N_per_m
                                : pt.k_bound_gil_N_per_m;
       pt.sim = k_crit_simulated(wall, guess, spec.rel_tol, spec.should_stop);
-    } catch (const Interrupted&) {
+    } catch (const runtime::Interrupted&) {
       stopped = true;
       return;
     } catch (...) {
@@ -316,7 +316,7 @@ std::vector<MapPoint> stability_map(const std::string& model_path,
     }
     if (spec.progress) spec.progress(++finished, points.size());
   });
-  if (stopped) throw Interrupted();
+  if (stopped) throw runtime::Interrupted();
   for (const std::exception_ptr& e : errors) {
     if (e) std::rethrow_exception(e);
   }
@@ -347,7 +347,7 @@ StabilityResult run_stability_study(const StabilityOptions& o) {
             .count();
   }
   // the last poll: from here the files go in
-  throw_if_stop_asked(o.should_stop);
+  runtime::throw_if_stop_asked(o.should_stop);
   if (!o.out_dir.empty()) r.files = write_stability_files(r, o.out_dir);
   return r;
 }

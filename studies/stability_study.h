@@ -34,7 +34,7 @@
 #include "output/svg_chart.h"
 #include "sim/mujoco_util.h"
 #include "studies/stability_theory.h"
-#include "studies/stop.h"
+#include "runtime/stop.h"
 
 namespace vmh::studies {
 
@@ -119,9 +119,10 @@ struct SimKcrit {
 // until one run decays and the other grows), then bisected until
 // (K_unstable - K_stable) / K_stable <= rel_tol. The guess only says where
 // to look; every K is judged by a run. `stop` (if set) is polled before
-// each run: Interrupted once it says so.
+// each run: runtime::Interrupted once it says so.
 SimKcrit k_crit_simulated(SliderWall& wall, double k_guess_N_per_m,
-                          double rel_tol = 2e-3, const StopFn& stop = {});
+                          double rel_tol = 2e-3,
+                          const runtime::StopFn& stop = {});
 
 // The whole comparison for one setting.
 struct StabilityReport {
@@ -135,9 +136,8 @@ struct StabilityReport {
 };
 
 StabilityReport study_stability(const std::string& model_path,
-                                const StabilityParams& p,
-                                double rel_tol = 2e-3,
-                                const StopFn& stop = {});
+                                const StabilityParams& p, double rel_tol = 2e-3,
+                                const runtime::StopFn& stop = {});
 
 // ---------------------------------------------------------------- map
 
@@ -152,8 +152,9 @@ struct MapSpec {
   // called from the workers with (points done, points); not set: nothing
   output::ProgressFn progress;
   // polled from the workers before each point and each run of its
-  // bisection; once it says so no point starts and Interrupted is thrown
-  StopFn should_stop;
+  // bisection; once it says so no point starts and runtime::Interrupted is
+  // thrown
+  runtime::StopFn should_stop;
 };
 
 struct MapPoint {
@@ -185,8 +186,8 @@ struct StabilityOptions {
   int jobs = 1;  // map points simulated at once
   output::ProgressFn progress;  // the map's (MapSpec::progress)
   // polled before each run of a bisection (each point's, for a map) and
-  // last before the files are written: Interrupted, nothing written
-  StopFn should_stop;
+  // last before the files are written: runtime::Interrupted, nothing written
+  runtime::StopFn should_stop;
   // where the CSV and the chart go (write_stability_files); empty: nothing
   std::string out_dir;
 };

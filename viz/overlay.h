@@ -11,7 +11,7 @@
 // The controller's quantities (device frame, its length unit) are converted
 // with controller/device_frame.h.
 //
-// What is drawn (colours as in the SVG views, studies/plot_svg.h):
+// What is drawn (colours as in the SVG views, thesis/plot_svg.h):
 //   kPath        the VM's path: the circle (a closed polyline in its plane),
 //                the sphere (three great circles of its mount frame), the
 //                surface (a square grid on the plane the probe's tip slides

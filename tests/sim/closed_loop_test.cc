@@ -1,7 +1,7 @@
 // The closed loop on the six thesis scenes: each steps with no MuJoCo
 // warning, holds the torque over the servo period, keeps its physics honest
 // (the hand's work matches the energy it moved). The thesis's claims on the
-// same scenes are tests/studies/claims_test.cc.
+// same scenes are tests/thesis/claims_test.cc.
 #include "sim/closed_loop.h"
 
 #include <gtest/gtest.h>

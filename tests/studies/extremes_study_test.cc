@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "controller/device_frame.h"
-#include "studies/run_case.h"
+#include "thesis/run_case.h"
 #include "tests/support/mujoco_guard.h"
 #include "tests/support/constants.h"
 

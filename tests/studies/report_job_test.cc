@@ -16,7 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-RenderFn rjt_no_picture() {
+thesis::RenderFn rjt_no_picture() {
   return [](const std::string&, const std::string&, std::string* why_not) {
     *why_not = "test";
     return std::optional<std::string>();
