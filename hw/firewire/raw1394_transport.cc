@@ -279,35 +279,28 @@ TransportStatus Raw1394Transport::receive(std::uint8_t* buf,
     }
     return TransportStatus::kDisconnected;
   }
+  const TransportStatus s = await_batch(timeout_s, size);
+  if (s != TransportStatus::kOk) return s;
+  return hand_over(buf, capacity, size, info);
+}
+
+// Runs every waiting event's handler, waiting for more up to timeout_s,
+// until a batch of packets is there (kOk), a bus reset or a wrong-size
+// packet is seen, the adapter goes or the time is up.
+TransportStatus Raw1394Transport::await_batch(double timeout_s,
+                                              std::size_t* size) noexcept {
   const double deadline = now_s() + timeout_s;
   for (;;) {
     // every event waiting: bus resets first, then every packet
     if (!drain(h_->ctrl, 16) || !drain(h_->rx, 4 * kRxBufferPackets)) {
       return TransportStatus::kDisconnected;
     }
-    if (reset_pending_) {
-      // what arrived across the reset is from before it
-      reset_pending_ = false;
-      needs_recovery_ = true;
-      receives_since_recovery_ = 0;
-      batch_ = 0;
-      rx_bad_ = false;
-      resets_.fetch_add(1, std::memory_order_relaxed);
-      return TransportStatus::kBusReset;
-    }
+    if (reset_pending_) return take_bus_reset();
     if (batch_ >= kRxBufferPackets && fresh_start_) {
-      // The first receive after start() or recover() found the receive
-      // buffer full: the packets queued before the servo loop's first tick
-      // (setting up its thread can take tens of milliseconds), and the
-      // newest of them stale, as the ones after it did not fit. Discarded;
-      // the next packet is the loop's first.
-      stale_.fetch_add(batch_, std::memory_order_relaxed);
-      batch_ = 0;
-      rx_bad_ = false;
-      fresh_start_ = false;
+      discard_stale_batch();
       continue;
     }
-    if (batch_ > 0) break;
+    if (batch_ > 0) return TransportStatus::kOk;
     if (rx_bad_) {
       rx_bad_ = false;
       *size = rx_bad_size_;
@@ -321,20 +314,56 @@ TransportStatus Raw1394Transport::receive(std::uint8_t* buf,
     const TransportStatus s = wait(left);
     if (s != TransportStatus::kOk) return s;
   }
+}
 
-  // the newest packet; the others of the batch superseded, some late
-  const std::uint32_t n = batch_;
+// A bus reset seen: the device must be recovered before anything more is
+// received.
+TransportStatus Raw1394Transport::take_bus_reset() noexcept {
+  // what arrived across the reset is from before it
+  reset_pending_ = false;
+  needs_recovery_ = true;
+  receives_since_recovery_ = 0;
+  batch_ = 0;
+  rx_bad_ = false;
+  resets_.fetch_add(1, std::memory_order_relaxed);
+  return TransportStatus::kBusReset;
+}
+
+// The first receive after start() or recover() found the receive buffer
+// full: the packets queued before the servo loop's first tick (setting up
+// its thread can take tens of milliseconds), and the newest of them stale,
+// as the ones after it did not fit. Discarded; the next packet is the
+// loop's first.
+void Raw1394Transport::discard_stale_batch() noexcept {
+  stale_.fetch_add(batch_, std::memory_order_relaxed);
+  batch_ = 0;
+  rx_bad_ = false;
+  fresh_start_ = false;
+}
+
+// How many of the batch's n packets are late: those beyond the record of
+// arrival cycles, and those that arrived late_cycles_ or more before the
+// newest.
+std::uint32_t Raw1394Transport::count_late(std::uint32_t n) const noexcept {
   const std::size_t kept = n < batch_cycles_.size() ? n : batch_cycles_.size();
   const unsigned newest = batch_cycles_[kept - 1];
-  std::uint32_t late = 0;
-  if (!fresh_start_) {
-    // (the first batch after a start came before any receive: none late)
-    late = static_cast<std::uint32_t>(n - kept);  // beyond the record
-    for (std::size_t i = 0; i + 1 < kept; ++i) {
-      const unsigned age = (newest + 8000u - batch_cycles_[i]) % 8000u;
-      if (age >= late_cycles_) ++late;
-    }
+  auto late = static_cast<std::uint32_t>(n - kept);  // beyond the record
+  for (std::size_t i = 0; i + 1 < kept; ++i) {
+    const unsigned age = (newest + 8000u - batch_cycles_[i]) % 8000u;
+    if (age >= late_cycles_) ++late;
   }
+  return late;
+}
+
+// Hands over the batch's newest packet; the others of the batch are
+// superseded, some late.
+TransportStatus Raw1394Transport::hand_over(std::uint8_t* buf,
+                                            std::size_t capacity,
+                                            std::size_t* size,
+                                            ReceiveInfo* info) noexcept {
+  const std::uint32_t n = batch_;
+  // (the first batch after a start came before any receive: none late)
+  const std::uint32_t late = fresh_start_ ? 0 : count_late(n);
   fresh_start_ = false;
   batch_ = 0;
   rx_bad_ = false;

@@ -200,6 +200,13 @@ class Raw1394Transport final : public Transport {
   bool drain(r1394::Handle h, int limit) noexcept;
   // waits up to timeout_s for the control or receive handle
   TransportStatus wait(double timeout_s) noexcept;
+  // receive()'s steps (raw1394_transport.cc says each)
+  TransportStatus await_batch(double timeout_s, std::size_t* size) noexcept;
+  TransportStatus take_bus_reset() noexcept;
+  void discard_stale_batch() noexcept;
+  std::uint32_t count_late(std::uint32_t n) const noexcept;
+  TransportStatus hand_over(std::uint8_t* buf, std::size_t capacity,
+                            std::size_t* size, ReceiveInfo* info) noexcept;
   void on_packet(const unsigned char* data, unsigned int len,
                  unsigned int cycle) noexcept;
 
