@@ -21,49 +21,62 @@ using namespace vmh::hd::detail;  // NOLINT: on the library's shared state
 
 namespace {
 
-// Every value a parameter has, as doubles (n of them), for the typed getters.
-// Returns n, 0 for a parameter that is not readable as a number.
-int read_numbers(HdDevice* d, HDenum p, double* out) {
-  HdFrame cur, last;
+// The frames a state call reads: the tick's own on the servo thread, else
+// the last published ones.
+void frames_of(HdDevice* d, HdFrame* cur, HdFrame* last) {
   if (on_servo_thread()) {
-    cur = d->current();
-    last = d->last();
+    *cur = d->current();
+    *last = d->last();
   } else {
-    d->published(&cur, &last);
+    d->published(cur, last);
   }
-  // a LAST_ parameter reads the previous frame under its CURRENT_ name
+}
+
+// A LAST_ parameter reads the previous frame under its CURRENT_ name: *q is
+// p's CURRENT_ name (p itself if it has none); true when p is a LAST_ one.
+bool current_name_of(HDenum p, HDenum* q) {
   bool is_last = true;
-  HDenum q = p;
+  *q = p;
   switch (p) {
-    case HD_LAST_FORCE: q = HD_CURRENT_FORCE; break;
-    case HD_LAST_TORQUE: q = HD_CURRENT_TORQUE; break;
-    case HD_LAST_JOINT_TORQUE: q = HD_CURRENT_JOINT_TORQUE; break;
-    case HD_LAST_GIMBAL_TORQUE: q = HD_CURRENT_GIMBAL_TORQUE; break;
-    case HD_LAST_MOTOR_DAC_VALUES: q = HD_CURRENT_MOTOR_DAC_VALUES; break;
+    case HD_LAST_FORCE: *q = HD_CURRENT_FORCE; break;
+    case HD_LAST_TORQUE: *q = HD_CURRENT_TORQUE; break;
+    case HD_LAST_JOINT_TORQUE: *q = HD_CURRENT_JOINT_TORQUE; break;
+    case HD_LAST_GIMBAL_TORQUE: *q = HD_CURRENT_GIMBAL_TORQUE; break;
+    case HD_LAST_MOTOR_DAC_VALUES: *q = HD_CURRENT_MOTOR_DAC_VALUES; break;
     default:
       if (p >= 0x2200 && p < 0x2400) {
-        q = p - 0x200;
+        *q = p - 0x200;
       } else {
         is_last = false;
       }
   }
-  // on the servo thread a command reads back what this frame set so far
-  if (!is_last && on_servo_thread()) {
-    const HdCommand& cmd = d->command();
-    switch (q) {
-      case HD_CURRENT_FORCE: std::copy(cmd.force_N, cmd.force_N + 3, cur.force_N); break;
-      case HD_CURRENT_JOINT_TORQUE:
-        std::copy(cmd.joint_torque_mNm, cmd.joint_torque_mNm + 3, cur.joint_torque_mNm);
-        break;
-      case HD_CURRENT_TORQUE:
-      case HD_CURRENT_GIMBAL_TORQUE:
-        std::copy(cmd.gimbal_torque_mNm, cmd.gimbal_torque_mNm + 3, cur.gimbal_torque_mNm);
-        break;
-      case HD_CURRENT_MOTOR_DAC_VALUES: std::copy(cmd.dac, cmd.dac + 3, cur.dac); break;
-      default: break;
-    }
+  return is_last;
+}
+
+// On the servo thread a command reads back what this frame set so far: the
+// command q (a CURRENT_ name) copied from the device's command into *cur.
+void read_back_command(HdDevice* d, HDenum q, HdFrame* cur) {
+  const HdCommand& cmd = d->command();
+  switch (q) {
+    case HD_CURRENT_FORCE: std::copy(cmd.force_N, cmd.force_N + 3, cur->force_N); break;
+    case HD_CURRENT_JOINT_TORQUE:
+      std::copy(cmd.joint_torque_mNm, cmd.joint_torque_mNm + 3, cur->joint_torque_mNm);
+      break;
+    case HD_CURRENT_TORQUE:
+    case HD_CURRENT_GIMBAL_TORQUE:
+      std::copy(cmd.gimbal_torque_mNm, cmd.gimbal_torque_mNm + 3, cur->gimbal_torque_mNm);
+      break;
+    case HD_CURRENT_MOTOR_DAC_VALUES: std::copy(cmd.dac, cmd.dac + 3, cur->dac); break;
+    default: break;
   }
-  const HdFrame& f = is_last ? last : cur;
+}
+
+// The table of the parameters readable as numbers: q's values (q a
+// CURRENT_ name) from frame f, or from cur where only the current frame
+// has them (the update rate), written to out. Returns how many, 0 for a
+// parameter that is not readable as a number.
+int frame_numbers(HdDevice* d, HDenum q, const HdFrame& f, const HdFrame& cur,
+                  double* out) {
   const auto copy = [out](const double* v, int n) {
     std::copy(v, v + n, out);
     return n;
@@ -133,6 +146,17 @@ int read_numbers(HdDevice* d, HDenum p, double* out) {
     case HD_USER_STATUS_LIGHT: out[0] = s.status_light.load(); return 1;
     default: return 0;
   }
+}
+
+// Every value a parameter has, as doubles (n of them), for the typed getters.
+// Returns n, 0 for a parameter that is not readable as a number.
+int read_numbers(HdDevice* d, HDenum p, double* out) {
+  HdFrame cur, last;
+  frames_of(d, &cur, &last);
+  HDenum q = p;
+  const bool is_last = current_name_of(p, &q);
+  if (!is_last && on_servo_thread()) read_back_command(d, q, &cur);
+  return frame_numbers(d, q, is_last ? last : cur, cur, out);
 }
 
 template <typename T, typename Convert>

@@ -129,6 +129,23 @@ class IdleLoop final : public ServoLoop {
 SchedulerLoop g_loop;
 IdleLoop g_idle;
 
+// VMH_HD_PACE: how many times faster than real time the lockstep thread
+// runs, 0 for as fast as it can ("free"); 1 when unset or not a number > 0
+double lockstep_pace() {
+  const char* pace = std::getenv("VMH_HD_PACE");
+  double factor = 1.0;
+  if (pace != nullptr && *pace != '\0') {
+    if (std::string(pace) == "free") {
+      factor = 0.0;
+    } else {
+      char* end = nullptr;
+      const double f = std::strtod(pace, &end);
+      if (end != pace && *end == '\0' && std::isfinite(f) && f > 0.0) factor = f;
+    }
+  }
+  return factor;
+}
+
 }  // namespace
 
 bool on_servo_thread() {
@@ -202,17 +219,7 @@ HDAPI void HDAPIENTRY hdStartScheduler(void) {
     // one servo period of every plant per tick, paced to the wall clock:
     // VMH_HD_PACE=free runs as fast as it can, VMH_HD_PACE=F (a number > 0)
     // F times faster than real time
-    const char* pace = std::getenv("VMH_HD_PACE");
-    double factor = 1.0;
-    if (pace != nullptr && *pace != '\0') {
-      if (std::string(pace) == "free") {
-        factor = 0.0;
-      } else {
-        char* end = nullptr;
-        const double f = std::strtod(pace, &end);
-        if (end != pace && *end == '\0' && std::isfinite(f) && f > 0.0) factor = f;
-      }
-    }
+    const double factor = lockstep_pace();
     c.lockstep_run.store(true);
     c.lockstep_thread = std::thread([devs, n, period_s, factor]() mutable {
       Context& cc = ctx();
