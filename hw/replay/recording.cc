@@ -148,8 +148,22 @@ DeviceError Recording::state_of(std::size_t i, DeviceState* st) const noexcept {
   return DeviceError::kOk;
 }
 
-Recording read_recording(const std::string& folder, const RecordingLimits& limits) {
-  Recording rec;
+namespace {
+
+// The current row's integers in three columns, each within int32's range.
+std::array<std::int32_t, 3> int32_cells(
+    const runtime::TraceReader& p, const std::array<std::size_t, 3>& cols) {
+  constexpr double kI32Lo = -2147483648.0, kI32Hi = 2147483647.0;
+  std::array<std::int32_t, 3> e{};
+  for (std::size_t k = 0; k < 3; ++k) {
+    e[k] = static_cast<std::int32_t>(p.integer(cols[k], kI32Lo, kI32Hi));
+  }
+  return e;
+}
+
+// The recording folder: given, there, a folder and not a file, with a
+// trace.csv in it; rec's folder (absolute where it can be) and trace file.
+void check_folder(const std::string& folder, Recording* rec) {
   if (folder.empty()) {
     throw RecordingError("replay: no recording folder given (replay:DIR, DIR "
                          "written by `vmhaptics hw record --out DIR`)");
@@ -168,21 +182,25 @@ Recording read_recording(const std::string& folder, const RecordingLimits& limit
                          "record --out DIR` wrote");
   }
   std::error_code ec;
-  rec.folder = fs::absolute(folder, ec).lexically_normal().string();
-  if (ec) rec.folder = folder;
-  rec.trace_file = (fs::path(rec.folder) / "trace.csv").string();
+  rec->folder = fs::absolute(folder, ec).lexically_normal().string();
+  if (ec) rec->folder = folder;
+  rec->trace_file = (fs::path(rec->folder) / "trace.csv").string();
 
   // the trace must be there: a replay needs its rows (meta.json may not)
   {
     struct stat tst {};
-    if (::stat(rec.trace_file.c_str(), &tst) != 0 && errno == ENOENT) {
-      throw RecordingError("replay: no trace.csv in '" + rec.folder +
+    if (::stat(rec->trace_file.c_str(), &tst) != 0 && errno == ENOENT) {
+      throw RecordingError("replay: no trace.csv in '" + rec->folder +
                            "' (a recording is the folder `vmhaptics hw record "
                            "--out DIR` wrote)");
     }
   }
-  // regular file, bounds, header, cells per row, t_s: the shared reader
-  runtime::TraceReader p(rec.trace_file, limits);
+}
+
+// The header's columns the reader takes: t_s and q1_rad..q6_rad, which
+// must be there, and the optional ones, each group all there or not at
+// all; rec's present bits say which groups are.
+Layout read_layout(const runtime::TraceReader& p, Recording* rec) {
   Layout L;
   L.t = p.require("t_s");
   for (int i = 0; i < 6; ++i) {
@@ -191,8 +209,8 @@ Recording read_recording(const std::string& folder, const RecordingLimits& limit
   L.read_error = p.find("read_error");
   L.buttons = p.find("buttons");
   L.docked = p.find("docked");
-  if (L.buttons != SIZE_MAX) rec.present |= kStateButtons;
-  if (L.docked != SIZE_MAX) rec.present |= kStateInkwell;
+  if (L.buttons != SIZE_MAX) rec->present |= kStateButtons;
+  if (L.docked != SIZE_MAX) rec->present |= kStateInkwell;
   {
     std::vector<std::string> n = names("dev_p_", kXyz, 3, "_mm");
     for (int r = 1; r <= 3; ++r) {
@@ -202,12 +220,12 @@ Recording read_recording(const std::string& folder, const RecordingLimits& limit
     }
     if (group(p, n, "the device's transform (dev_p_*_mm, dev_R_11..33)",
                 &L.transform)) {
-      rec.present |= kStateTransform;
+      rec->present |= kStateTransform;
     }
   }
   if (group(p, names("dev_v_", kXyz, 3, "_mm_s"),
               "the device's velocity (dev_v_*_mm_s)", &L.velocity)) {
-    rec.present |= kStateVelocity;
+    rec->present |= kStateVelocity;
   }
   {
     std::vector<std::string> n;
@@ -217,81 +235,92 @@ Recording read_recording(const std::string& folder, const RecordingLimits& limit
       }
     }
     if (group(p, n, "the device's Jacobian (dev_J_11..66)", &L.jacobian)) {
-      rec.present |= kStateJacobian;
+      rec->present |= kStateJacobian;
     }
   }
   {
     const char* const e[] = {"1", "2", "3"};
     const char* const q[] = {"4", "5", "6"};
     if (group(p, names("enc_", e, 3, ""), "the encoder counts (enc_1..3)", &L.enc)) {
-      rec.present |= kStateEncoders;
+      rec->present |= kStateEncoders;
     }
     if (group(p, names("pot_", q, 3, ""), "the gimbal pots (pot_4..6)", &L.pot)) {
-      rec.present |= kStatePots;
+      rec->present |= kStatePots;
     }
   }
+  return L;
+}
 
-  while (p.next()) {
-    const double t = p.t_s();
-    const std::vector<std::string_view>& cells = p.cells();
-    DeviceError err = DeviceError::kOk;
-    if (L.read_error != SIZE_MAX &&
-        !parse_device_error(std::string(cells[L.read_error]), &err)) {
-      throw RecordingError(p.where(L.read_error) + ": '" +
-                           std::string(cells[L.read_error]).substr(0, 40) + "' is not a read error's name "
-                           "(ok, not_connected, io, timeout, sensor_fault, "
-                           "invalid_command)");
-    }
-    const bool good = err == DeviceError::kOk;
-    // a good row's values must be finite numbers; a failed read's may be nan
-    const auto value = [&](std::size_t col) {
-      return good ? p.finite(col) : p.number(col);
-    };
-    Joints q_dh;
-    for (int i = 0; i < 6; ++i) q_dh[i] = value(L.q[static_cast<std::size_t>(i)]);
-    rec.time_s.push_back(t);
-    rec.read_error.push_back(err);
-    rec.q_device_rad.push_back(good ? dh_to_device_joints(q_dh)
-                                    : Joints::Constant(std::nan("")));
-    // the switches are written on every row, good or not
-    if (rec.present & kStateButtons) {
-      rec.buttons.push_back(
-          static_cast<std::uint32_t>(p.integer(L.buttons, 0, 4294967295.0)));
-    }
-    if (rec.present & kStateInkwell) {
-      rec.docked.push_back(static_cast<std::uint8_t>(p.integer(L.docked, 0, 1)));
-    }
-    if (rec.present & kStateTransform) {
-      std::array<double, 12> m{};
-      for (std::size_t k = 0; k < 12; ++k) m[k] = value(L.transform[k]);
-      rec.transform.push_back(m);
-    }
-    if (rec.present & kStateVelocity) {
-      std::array<double, 3> v{};
-      for (std::size_t k = 0; k < 3; ++k) v[k] = value(L.velocity[k]);
-      rec.velocity_mm_s.push_back(v);
-    }
-    if (rec.present & kStateJacobian) {
-      std::array<double, 36> j{};
-      for (std::size_t k = 0; k < 36; ++k) j[k] = value(L.jacobian[k]);
-      rec.jacobian.push_back(j);
-    }
-    constexpr double kI32Lo = -2147483648.0, kI32Hi = 2147483647.0;
-    if (rec.present & kStateEncoders) {
-      std::array<std::int32_t, 3> e{};
-      for (std::size_t k = 0; k < 3; ++k) {
-        e[k] = static_cast<std::int32_t>(p.integer(L.enc[k], kI32Lo, kI32Hi));
-      }
-      rec.encoders.push_back(e);
-    }
-    if (rec.present & kStatePots) {
-      std::array<std::int32_t, 3> e{};
-      for (std::size_t k = 0; k < 3; ++k) {
-        e[k] = static_cast<std::int32_t>(p.integer(L.pot[k], kI32Lo, kI32Hi));
-      }
-      rec.pots.push_back(e);
-    }
+// The current row's read error: ok without a read_error column, else the
+// error the cell names (a RecordingError if it names none).
+DeviceError row_error(const runtime::TraceReader& p, const Layout& L) {
+  const std::vector<std::string_view>& cells = p.cells();
+  DeviceError err = DeviceError::kOk;
+  if (L.read_error != SIZE_MAX &&
+      !parse_device_error(std::string(cells[L.read_error]), &err)) {
+    throw RecordingError(p.where(L.read_error) + ": '" +
+                         std::string(cells[L.read_error]).substr(0, 40) + "' is not a read error's name "
+                         "(ok, not_connected, io, timeout, sensor_fault, "
+                         "invalid_command)");
   }
+  return err;
+}
+
+// The current row appended to rec: its time, read error and joints (the
+// trace's DH angles in the device's convention), then every group of
+// columns the trace has.
+void read_row(const runtime::TraceReader& p, const Layout& L, Recording* rec) {
+  const double t = p.t_s();
+  const DeviceError err = row_error(p, L);
+  const bool good = err == DeviceError::kOk;
+  // a good row's values must be finite numbers; a failed read's may be nan
+  const auto value = [&](std::size_t col) {
+    return good ? p.finite(col) : p.number(col);
+  };
+  Joints q_dh;
+  for (int i = 0; i < 6; ++i) q_dh[i] = value(L.q[static_cast<std::size_t>(i)]);
+  rec->time_s.push_back(t);
+  rec->read_error.push_back(err);
+  rec->q_device_rad.push_back(good ? dh_to_device_joints(q_dh)
+                                   : Joints::Constant(std::nan("")));
+  // the switches are written on every row, good or not
+  if (rec->present & kStateButtons) {
+    rec->buttons.push_back(
+        static_cast<std::uint32_t>(p.integer(L.buttons, 0, 4294967295.0)));
+  }
+  if (rec->present & kStateInkwell) {
+    rec->docked.push_back(static_cast<std::uint8_t>(p.integer(L.docked, 0, 1)));
+  }
+  if (rec->present & kStateTransform) {
+    std::array<double, 12> m{};
+    for (std::size_t k = 0; k < 12; ++k) m[k] = value(L.transform[k]);
+    rec->transform.push_back(m);
+  }
+  if (rec->present & kStateVelocity) {
+    std::array<double, 3> v{};
+    for (std::size_t k = 0; k < 3; ++k) v[k] = value(L.velocity[k]);
+    rec->velocity_mm_s.push_back(v);
+  }
+  if (rec->present & kStateJacobian) {
+    std::array<double, 36> j{};
+    for (std::size_t k = 0; k < 36; ++k) j[k] = value(L.jacobian[k]);
+    rec->jacobian.push_back(j);
+  }
+  if (rec->present & kStateEncoders) {
+    rec->encoders.push_back(int32_cells(p, L.enc));
+  }
+  if (rec->present & kStatePots) rec->pots.push_back(int32_cells(p, L.pot));
+}
+
+}  // namespace
+
+Recording read_recording(const std::string& folder, const RecordingLimits& limits) {
+  Recording rec;
+  check_folder(folder, &rec);
+  // regular file, bounds, header, cells per row, t_s: the shared reader
+  runtime::TraceReader p(rec.trace_file, limits);
+  const Layout L = read_layout(p, &rec);
+  while (p.next()) read_row(p, L, &rec);
   if (rec.rows() == 0) {
     throw RecordingError(rec.trace_file +
                          ": no rows after the header: the recording is empty");
