@@ -207,7 +207,10 @@ TouchProbe probe_touch(const std::optional<BusAddress>& where) {
   return p;
 }
 
-CaptureResult capture_touch(const CaptureOptions& o) {
+namespace {
+
+// A capture's options: a finite duration > 0 s and an output file.
+void check_capture_options(const CaptureOptions& o) {
   if (!std::isfinite(o.duration_s) || !(o.duration_s > 0.0)) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%g", o.duration_s);
@@ -215,77 +218,118 @@ CaptureResult capture_touch(const CaptureOptions& o) {
                         ": must be a finite number of seconds > 0");
   }
   if (o.out_path.empty()) throw UsbUsageError("--out: a capture file is required");
+}
 
-  UsbContext ctx;
-  UsbDeviceList list(ctx);
-  const UsbDeviceInfo& d = select_touch(list, o.where);
-  const std::string who = describe(d);
-  const UsbDescriptors desc = read_descriptors(d);
-  const UsbConfiguration* config = find_configuration(desc, active_configuration(d, desc));
-  if (config == nullptr) {
+// What a capture reads: the active configuration, its data interface (both
+// in the descriptors they were found in) and that interface's IN endpoints.
+struct CaptureTarget {
+  const UsbConfiguration* config = nullptr;
+  const UsbInterface* intf = nullptr;
+  std::vector<UsbEndpoint> eps;
+};
+
+CaptureTarget capture_target(const UsbDeviceInfo& d, const UsbDescriptors& desc,
+                             const std::string& who) {
+  CaptureTarget t;
+  t.config = find_configuration(desc, active_configuration(d, desc));
+  if (t.config == nullptr) {
     throw UsbDeviceError(who + ": no active configuration in its descriptors");
   }
-  const UsbInterface* intf = find_data_interface(*config);
-  if (intf == nullptr) {
+  t.intf = find_data_interface(*t.config);
+  if (t.intf == nullptr) {
     throw UsbDeviceError(who + ": no interface with a bulk or interrupt IN endpoint");
   }
-  const std::vector<UsbEndpoint> eps = capture_endpoints(*intf);
-  if (eps.empty()) {
-    throw UsbDeviceError(who + ": interface " + std::to_string(intf->number) +
+  t.eps = capture_endpoints(*t.intf);
+  if (t.eps.empty()) {
+    throw UsbDeviceError(who + ": interface " + std::to_string(t.intf->number) +
                          " has no bulk or interrupt IN endpoint to read");
   }
+  return t;
+}
 
-  int error = 0;
-  UsbHandle handle(d.device, &error);
-  CaptureResult r;
-  r.device = listing(d, error);
-  if (!handle.is_open()) throw UsbDeviceError(who + ": " + r.device.why_not);
-  r.interface_number = intf->number;
-  for (const UsbEndpoint& e : eps) r.endpoints.push_back(e.address);
-
+// Who holds the data interface (r->kernel_driver, empty for no one); a
+// UsbDeviceError unless the capture may detach it.
+void check_kernel_driver(const UsbDeviceInfo& d, UsbHandle* handle,
+                         const CaptureTarget& t, const std::string& who,
+                         bool detach, CaptureResult* r) {
   // a kernel driver (cdc_acm) holds the data interface: release it only
   // when asked to, since that takes the device away from its serial port
-  r.kernel_driver = sysfs_interface_driver(d.port_path, config->value, intf->number);
-  const std::optional<bool> active = kernel_driver_active(&handle, intf->number);
-  if (r.kernel_driver.empty() && active.value_or(false)) r.kernel_driver = "a kernel driver";
-  if (!r.kernel_driver.empty() && !o.detach) {
-    throw UsbDeviceError("interface " + std::to_string(intf->number) + " of " + who +
-                         " is held by " + r.kernel_driver +
+  r->kernel_driver = sysfs_interface_driver(d.port_path, t.config->value, t.intf->number);
+  const std::optional<bool> active = kernel_driver_active(handle, t.intf->number);
+  if (r->kernel_driver.empty() && active.value_or(false)) r->kernel_driver = "a kernel driver";
+  if (!r->kernel_driver.empty() && !detach) {
+    throw UsbDeviceError("interface " + std::to_string(t.intf->number) + " of " + who +
+                         " is held by " + r->kernel_driver +
                          "; pass --detach to release it for the capture (it is "
                          "re-attached afterwards)");
   }
-  ClaimedInterface claim(&handle, intf->number, o.detach, who);
-  r.detached = claim.detached();
+}
 
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(o.out_path.c_str(), "w"));
-  if (!file) {
-    throw UsbUsageError("--out " + o.out_path + ": cannot write: " + std::strerror(errno));
-  }
-  r.out_path = o.out_path;
+// The capture file's header (hw/usb/README.md, "Capture format").
+void write_capture_header(std::FILE* file, const UsbDeviceInfo& d,
+                          const CaptureOptions& o, const CaptureResult& r) {
   CaptureHeader h;
   h.device_id = r.device.id;
   h.where = {d.bus, d.address};
   h.port_path = d.port_path;
-  h.interface_number = intf->number;
+  h.interface_number = r.interface_number;
   h.endpoints = r.endpoints;
   h.duration_s = o.duration_s;
   h.started_utc = utc_now();
-  std::fputs(format_capture_header(h).c_str(), file.get());
-  std::fflush(file.get());
+  std::fputs(format_capture_header(h).c_str(), file);
+  std::fflush(file);
+}
 
+// A transfer's outcome in r: a timeout with no data counted, a failure's
+// cause in r->error (which ends the capture).
+void note_outcome(const TransferResult& t, const UsbEndpoint& ep,
+                  const std::string& who, CaptureResult* r) {
+  char epname[8];
+  std::snprintf(epname, sizeof epname, "0x%02x", static_cast<unsigned>(ep.address));
+  switch (t.outcome) {
+    case TransferOutcome::kCompleted: break;
+    case TransferOutcome::kTimedOut:
+      if (t.data.empty()) ++r->timeouts;
+      break;
+    case TransferOutcome::kNoDevice:
+      r->device_lost = true;
+      r->error = "the Touch " + who + " was unplugged during the capture "
+                 "(LIBUSB_ERROR_NO_DEVICE on endpoint " + epname + ")";
+      break;
+    case TransferOutcome::kStall:
+      r->error = "endpoint " + std::string(epname) + " of " + who + " stalled";
+      break;
+    case TransferOutcome::kOverflow:
+      r->error = "endpoint " + std::string(epname) + " of " + who +
+                 " sent more than wMaxPacketSize (" + std::to_string(ep.max_packet_size) +
+                 " bytes)";
+      break;
+    case TransferOutcome::kError:
+      r->error = "reading endpoint " + std::string(epname) + " of " + who + ": " + t.detail;
+      break;
+  }
+}
+
+// The capture itself: one IN transfer at a time, the endpoints in turn, each
+// written to the file as it arrives, until o.duration_s is up or something
+// fails (r->error); r->elapsed_s the time it took.
+void capture_transfers(const UsbContext& ctx, UsbHandle* handle,
+                       const std::vector<UsbEndpoint>& eps,
+                       const CaptureOptions& o, const std::string& who,
+                       std::FILE* file, CaptureResult* r) {
   const Clock::time_point t0 = Clock::now();
   const auto elapsed_s = [&]() {
     return std::chrono::duration<double>(Clock::now() - t0).count();
   };
   std::size_t next = 0;
-  while (r.error.empty()) {
+  while (r->error.empty()) {
     const double left_s = o.duration_s - elapsed_s();
     if (left_s <= 0.0) break;
     const UsbEndpoint& ep = eps[next];
     next = (next + 1) % eps.size();
     const unsigned timeout_ms = static_cast<unsigned>(
         std::max(1.0, std::min<double>(o.transfer_timeout_ms, std::ceil(1e3 * left_s))));
-    const TransferResult t = read_in_endpoint(ctx, &handle, ep.address,
+    const TransferResult t = read_in_endpoint(ctx, handle, ep.address,
                                               ep.transfer_type == "interrupt",
                                               ep.max_packet_size, timeout_ms);
     const double t_s = elapsed_s();
@@ -293,39 +337,47 @@ CaptureResult capture_touch(const CaptureOptions& o) {
         (t.outcome == TransferOutcome::kTimedOut && !t.data.empty())) {
       const std::string line =
           format_capture_record(t_s, ep.address, t.data.data(), t.data.size());
-      if (std::fputs(line.c_str(), file.get()) < 0 || std::fflush(file.get()) != 0) {
-        r.error = "writing " + o.out_path + ": " + std::strerror(errno);
+      if (std::fputs(line.c_str(), file) < 0 || std::fflush(file) != 0) {
+        r->error = "writing " + o.out_path + ": " + std::strerror(errno);
         break;
       }
-      ++r.transfers;
-      r.bytes += t.data.size();
+      ++r->transfers;
+      r->bytes += t.data.size();
     }
-    char epname[8];
-    std::snprintf(epname, sizeof epname, "0x%02x", static_cast<unsigned>(ep.address));
-    switch (t.outcome) {
-      case TransferOutcome::kCompleted: break;
-      case TransferOutcome::kTimedOut:
-        if (t.data.empty()) ++r.timeouts;
-        break;
-      case TransferOutcome::kNoDevice:
-        r.device_lost = true;
-        r.error = "the Touch " + who + " was unplugged during the capture "
-                  "(LIBUSB_ERROR_NO_DEVICE on endpoint " + epname + ")";
-        break;
-      case TransferOutcome::kStall:
-        r.error = "endpoint " + std::string(epname) + " of " + who + " stalled";
-        break;
-      case TransferOutcome::kOverflow:
-        r.error = "endpoint " + std::string(epname) + " of " + who +
-                  " sent more than wMaxPacketSize (" + std::to_string(ep.max_packet_size) +
-                  " bytes)";
-        break;
-      case TransferOutcome::kError:
-        r.error = "reading endpoint " + std::string(epname) + " of " + who + ": " + t.detail;
-        break;
-    }
+    note_outcome(t, ep, who, r);
   }
-  r.elapsed_s = elapsed_s();
+  r->elapsed_s = elapsed_s();
+}
+
+}  // namespace
+
+CaptureResult capture_touch(const CaptureOptions& o) {
+  check_capture_options(o);
+  UsbContext ctx;
+  UsbDeviceList list(ctx);
+  const UsbDeviceInfo& d = select_touch(list, o.where);
+  const std::string who = describe(d);
+  const UsbDescriptors desc = read_descriptors(d);
+  const CaptureTarget target = capture_target(d, desc, who);
+
+  int error = 0;
+  UsbHandle handle(d.device, &error);
+  CaptureResult r;
+  r.device = listing(d, error);
+  if (!handle.is_open()) throw UsbDeviceError(who + ": " + r.device.why_not);
+  r.interface_number = target.intf->number;
+  for (const UsbEndpoint& e : target.eps) r.endpoints.push_back(e.address);
+  check_kernel_driver(d, &handle, target, who, o.detach, &r);
+  ClaimedInterface claim(&handle, target.intf->number, o.detach, who);
+  r.detached = claim.detached();
+
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(o.out_path.c_str(), "w"));
+  if (!file) {
+    throw UsbUsageError("--out " + o.out_path + ": cannot write: " + std::strerror(errno));
+  }
+  r.out_path = o.out_path;
+  write_capture_header(file.get(), d, o, r);
+  capture_transfers(ctx, &handle, target.eps, o, who, file.get(), &r);
   const std::string last = r.error.empty()
                                ? format_capture_end(r.transfers, r.bytes, r.timeouts, r.elapsed_s)
                                : format_capture_error(r.error, r.transfers);
