@@ -98,9 +98,27 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
   ReceiveInfo info;
   const TransportStatus ts = transport_->receive(
       rx_.data(), rx_.size(), &size, options_.receive_timeout_s, &info);
+  if (ts != TransportStatus::kOk) return receive_failed(ts);
+
+  StatePacket p;
+  if (size > rx_.size() ||
+      decode_state(rx_.data(), size, &p) != PacketError::kOk) {
+    ++s_.bad_packets;
+    publish();
+    return DeviceError::kIo;
+  }
+  count_packet(p, info);
+  unwrap_counts(p);
+  last_.write(p);
+  const bool docked = p.docked();
+  const bool rehomed = take_calibration(docked);
+  publish();
+  return fill_state(p, docked, rehomed, state);
+}
+
+// A receive that gave no packet: counted, and a bus reset answered.
+DeviceError FirewireOmni::receive_failed(TransportStatus ts) noexcept {
   switch (ts) {
-    case TransportStatus::kOk:
-      break;
     case TransportStatus::kTimeout:
       ++s_.timeouts;
       publish();
@@ -124,18 +142,18 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
       ++s_.bad_packets;
       publish();
       return DeviceError::kIo;
+    case TransportStatus::kOk:  // (not called with it)
     case TransportStatus::kDisconnected:
     case TransportStatus::kIo:
       return device_error_of(ts);
   }
+  return device_error_of(ts);
+}
 
-  StatePacket p;
-  if (size > rx_.size() ||
-      decode_state(rx_.data(), size, &p) != PacketError::kOk) {
-    ++s_.bad_packets;
-    publish();
-    return DeviceError::kIo;
-  }
+// A decoded packet counted: the packets that came with it superseded, some
+// late, and those its counter says never arrived lost.
+void FirewireOmni::count_packet(const StatePacket& p,
+                                const ReceiveInfo& info) noexcept {
   ++s_.packets;
   const std::uint32_t arrived = info.packets > 0 ? info.packets : 1u;
   s_.superseded_packets += arrived - 1u;
@@ -149,15 +167,21 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
   }
   have_counter_ = true;
   s_.last_counter = p.counter;
+}
 
+// The packet's int16 encoder readings unwrapped into the running counts.
+void FirewireOmni::unwrap_counts(const StatePacket& p) noexcept {
   for (std::size_t i = 0; i < 3; ++i) {
     counts_[i] = have_counts_ ? unwrap_encoder(counts_[i], p.encoders[i])
                               : static_cast<std::int32_t>(p.encoders[i]);
   }
   have_counts_ = true;
-  last_.write(p);
+}
 
-  // the calibration in use: a newly set one, the inkwell's offsets
+// The calibration in use: a newly set one, the inkwell's offsets while the
+// stylus is docked (re-homing, if the options allow it), published for
+// calibration(). True when this packet re-homed the encoders.
+bool FirewireOmni::take_calibration(bool docked) noexcept {
   bool changed = false;
   const std::uint64_t gen = cal_gen_.load(std::memory_order_acquire);
   if (gen != cal_local_gen_) {
@@ -165,7 +189,6 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
     cal_local_gen_ = gen;
     changed = true;
   }
-  const bool docked = p.docked();
   bool rehomed = false;
   if (options_.rehome_in_inkwell && docked) {
     const std::array<double, 3> off = docked_encoder_offsets(counts_, cal_local_);
@@ -181,8 +204,14 @@ DeviceError FirewireOmni::read_state(DeviceState* state) noexcept {
     in_use_.write(cal_local_);
     in_use_gen_.store(cal_local_gen_, std::memory_order_release);
   }
-  publish();
+  return rehomed;
+}
 
+// The reading: the pots' codes (an open pot is a sensor fault), the angles
+// through the calibration in use, the switches, the raw counts and codes.
+DeviceError FirewireOmni::fill_state(const StatePacket& p, bool docked,
+                                     bool rehomed,
+                                     DeviceState* state) noexcept {
   PotCodes pots{};
   for (std::size_t i = 0; i < 3; ++i) {
     pots[i] = pot_code(p.gimbal_a[i], p.gimbal_b[i]);

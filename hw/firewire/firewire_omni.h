@@ -181,6 +181,13 @@ class FirewireOmni final : public HapticDevice {
 
   DeviceError send_command(const CommandPacket& c) noexcept;
   void publish() noexcept { stats_.write(s_); }
+  // read_state()'s steps (firewire_omni.cc says each)
+  DeviceError receive_failed(TransportStatus ts) noexcept;
+  void count_packet(const StatePacket& p, const ReceiveInfo& info) noexcept;
+  void unwrap_counts(const StatePacket& p) noexcept;
+  bool take_calibration(bool docked) noexcept;
+  DeviceError fill_state(const StatePacket& p, bool docked, bool rehomed,
+                         DeviceState* state) noexcept;
 };
 
 // The backend: owns the transport and the device, runs the loop on the
