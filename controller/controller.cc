@@ -82,6 +82,59 @@ void Controller::reset() noexcept {
   e_dot_filtered_.setZero();
 }
 
+namespace {
+
+// whether `seed` has a lower placement cost r^T W r than `warm`
+bool lower_cost(const VirtualMechanism& vm, const RmPose& rm, const Vec6& w,
+                const VmAngles& seed, const VmAngles& warm) {
+  const Vec6 r_warm = placement_residual(vm, rm, warm);
+  const Vec6 r_seed = placement_residual(vm, rm, seed);
+  return r_seed.dot(w.cwiseProduct(r_seed)) <
+         r_warm.dot(w.cwiseProduct(r_warm));
+}
+
+// *theta, the warm start, replaced by the closed form's `seed` where that
+// is better under W: a warm start can sit on the wrong side of a circle
+// after a fast move, and for W_p the closed form is already the answer
+void start_from_better(const VirtualMechanism& vm, const RmPose& rm,
+                       const Vec6& w, const VmAngles& seed, VmAngles* theta) {
+  if ((w.tail<3>().array() != 0.0).any()) {
+    if (lower_cost(vm, rm, w, seed, *theta)) *theta = seed;
+  } else if (vm.nearest_minimises_distance() && w[1] == w[0] && w[2] == w[0]) {
+    // W_p with equal weights is the distance, and the seed minimises it
+    // over the whole path: the warm start cannot be lower
+    *theta = seed;
+  } else {
+    // the orientation rows would add exactly 0: positions only
+    const Vec3 r_warm = rm.p - vm.position(*theta);
+    const Vec3 r_seed = rm.p - vm.position(seed);
+    if (r_seed.dot(w.head<3>().cwiseProduct(r_seed)) <
+        r_warm.dot(w.head<3>().cwiseProduct(r_warm))) {
+      *theta = seed;
+    }
+  }
+}
+
+// Where the VM has its cost's minimiser in closed form (the surface under
+// block-isotropic W), *theta replaced by it if it is better still (*seed
+// the workspace): the surface's iteration converges only linearly (its
+// residual does not vanish), so from a warm start alone it took ~35
+// iterations per tick
+void start_from_minimum(const VirtualMechanism& vm, const RmPose& rm,
+                        const Vec6& w, JointMask locked, VmAngles* seed,
+                        VmAngles* theta) {
+  const bool isotropic =
+      w[1] == w[0] && w[2] == w[0] && w[4] == w[3] && w[5] == w[3];
+  if (!isotropic || !(locked == 0u || locked == vm.stick_joints())) return;
+  *seed = *theta;
+  if (vm.placement_minimum(rm, w[0], w[3], locked != 0u, seed) &&
+      lower_cost(vm, rm, w, *seed, *theta)) {
+    *theta = *seed;
+  }
+}
+
+}  // namespace
+
 ControlStatus Controller::place(const RmPose& rm, JointMask locked,
                                 ControlOutput* out, VmPose* pose,
                                 bool* posed) noexcept {
@@ -117,53 +170,9 @@ ControlStatus Controller::place(const RmPose& rm, JointMask locked,
     // anyway (closed_form_cost)
     return st;
   }
-  if (seed_ok) {
-    // start from the better of the warm start and the closed form: a warm
-    // start can sit on the wrong side of a circle after a fast move, and
-    // for W_p the closed form is already the answer
-    const Vec6& w = params_.placement_options.weights;
-    if ((w.tail<3>().array() != 0.0).any()) {
-      const Vec6 r_warm = placement_residual(*vm_, rm, theta_v_);
-      const Vec6 r_seed = placement_residual(*vm_, rm, seed_);
-      if (r_seed.dot(w.cwiseProduct(r_seed)) <
-          r_warm.dot(w.cwiseProduct(r_warm))) {
-        theta_v_ = seed_;
-      }
-    } else if (vm_->nearest_minimises_distance() && w[1] == w[0] &&
-               w[2] == w[0]) {
-      // W_p with equal weights is the distance, and the seed minimises it
-      // over the whole path: the warm start cannot be lower
-      theta_v_ = seed_;
-    } else {
-      // the orientation rows would add exactly 0: positions only
-      const Vec3 r_warm = rm.p - vm_->position(theta_v_);
-      const Vec3 r_seed = rm.p - vm_->position(seed_);
-      if (r_seed.dot(w.head<3>().cwiseProduct(r_seed)) <
-          r_warm.dot(w.head<3>().cwiseProduct(r_warm))) {
-        theta_v_ = seed_;
-      }
-    }
-  }
-  // where the VM has its cost's minimiser in closed form (the surface under
-  // block-isotropic W), Gauss-Newton starts from it if it is better still:
-  // the surface's iteration converges only linearly (its residual does not
-  // vanish), so from a warm start alone it took ~35 iterations per tick
-  {
-    const Vec6& w = params_.placement_options.weights;
-    const bool isotropic = w[1] == w[0] && w[2] == w[0] && w[4] == w[3] &&
-                           w[5] == w[3];
-    if (isotropic && (locked == 0u || locked == vm_->stick_joints())) {
-      seed_ = theta_v_;
-      if (vm_->placement_minimum(rm, w[0], w[3], locked != 0u, &seed_)) {
-        const Vec6 r_warm = placement_residual(*vm_, rm, theta_v_);
-        const Vec6 r_seed = placement_residual(*vm_, rm, seed_);
-        if (r_seed.dot(w.cwiseProduct(r_seed)) <
-            r_warm.dot(w.cwiseProduct(r_warm))) {
-          theta_v_ = seed_;
-        }
-      }
-    }
-  }
+  const Vec6& w = params_.placement_options.weights;
+  if (seed_ok) start_from_better(*vm_, rm, w, seed_, &theta_v_);
+  start_from_minimum(*vm_, rm, w, locked, &seed_, &theta_v_);
   // the pose and J_V at the seed serve while theta_V is still the seed,
   // bit for bit (a converged step below the angles' ulp leaves it so)
   const bool start_posed = seed_posed && theta_v_ == posed_at;
