@@ -65,6 +65,15 @@ void surface_angles(const Vec3& d, VmAngles* theta) {
     (*theta)[2] = std::atan2(d.z(), d.y());
   }
 }
+
+// The contact under the probe's tip, p - L u projected on the plane, into
+// theta's s1, s2
+void slide_under(const VmMount& mount, double L, const Vec3& p, const Vec3& u,
+                 VmAngles* theta) {
+  const Vec3 tip = p - L * u - mount.origin;
+  (*theta)[0] = mount.R.col(0).dot(tip);
+  (*theta)[1] = mount.R.col(1).dot(tip);
+}
 }  // namespace
 
 bool SurfaceVm::nearest(const RmPose& rm, VmAngles* theta) const {
@@ -80,15 +89,71 @@ bool SurfaceVm::aligned(const RmPose& rm, VmAngles* theta) const {
   if (!(n > kPoleSin)) return false;
   const Vec3 a = rm.axis / n;
   surface_angles(mount_.R.transpose() * a, theta);
-  const Vec3 tip = rm.p - length_ * a - mount_.origin;
-  (*theta)[0] = mount_.R.col(0).dot(tip);
-  (*theta)[1] = mount_.R.col(1).dot(tip);
+  slide_under(mount_, length_, rm.p, a, theta);
   return true;
 }
 
-bool SurfaceVm::placement_minimum(const RmPose& rm, double w_pos,
-                                  double w_ornt, bool contact_held,
-                                  VmAngles* theta) const {
+namespace {
+
+// placement_minimum's cost along the angle psi between the probe and the
+// reference direction e, up to a constant (vm_surface.h): with the contact
+// held at distance dn from the RM, -2 w_pos L dn cos psi + w_ornt (psi -
+// psi_a)^2; free, with the RM at height h over the plane, w_pos (h - L cos
+// psi)^2 + w_ornt (psi - psi_a)^2. Its derivatives g' and g'' into *g1 and
+// *g2 where given
+struct ProbeAngleCost {
+  bool contact_held;
+  double w_pos, w_ornt, L, dn, h, psi_a;
+
+  double operator()(double x, double* g1, double* g2) const {
+    const SinCos sc = sin_cos(x);
+    const double o = x - psi_a;
+    if (contact_held) {
+      const double k = w_pos * L * dn;
+      if (g1 != nullptr) *g1 = 2.0 * (k * sc.s + w_ornt * o);
+      if (g2 != nullptr) *g2 = 2.0 * (k * sc.c + w_ornt);
+      return -2.0 * k * sc.c + w_ornt * o * o;
+    }
+    const double rn = h - L * sc.c;
+    if (g1 != nullptr) *g1 = 2.0 * (w_pos * rn * L * sc.s + w_ornt * o);
+    if (g2 != nullptr) {
+      *g2 = 2.0 * (w_pos * L * (L * sc.s * sc.s + rn * sc.c) + w_ornt);
+    }
+    return w_pos * rn * rn + w_ornt * o * o;
+  }
+};
+
+// The minimiser of the cost over psi in [0, pi] from psi: Newton where it
+// is convex, else a bounded descent step, each halved until the cost does
+// not increase
+double minimise_probe_angle(const ProbeAngleCost& cost, double psi) {
+  double g1 = 0.0, g2 = 0.0;
+  double g = cost(psi, &g1, &g2);
+  bool done = false;
+  for (int it = 0; it < 50 && !done; ++it) {
+    double step = g2 > 0.0 ? -g1 / g2 : (g1 > 0.0 ? -0.25 : 0.25);
+    step = std::clamp(step, -0.5, 0.5);
+    for (int half = 0; half < 40; ++half) {
+      const double x = std::clamp(psi + step, 0.0, kPi);
+      const double gx = cost(x, nullptr, nullptr);
+      if (gx <= g) {
+        done = std::abs(x - psi) < 1e-15 * (1.0 + std::abs(psi)) ||
+               std::abs(step) < 1e-13;
+        psi = x;
+        g = cost(psi, &g1, &g2);
+        break;
+      }
+      step *= 0.5;
+      if (half == 39) done = true;
+    }
+  }
+  return psi;
+}
+
+}  // namespace
+
+bool SurfaceVm::placement_minimum(const RmPose& rm, double w_pos, double w_ornt,
+                                  bool contact_held, VmAngles* theta) const {
   if (!(w_ornt > 0.0) || !(w_pos >= 0.0)) return false;
   const double na = rm.axis.norm();
   if (!(na > kPoleSin)) return false;
@@ -115,58 +180,17 @@ bool SurfaceVm::placement_minimum(const RmPose& rm, double w_pos,
   const double psi_a = std::atan2(sa, ca);
   // start from the current probe's angle to e
   const SinCos t_alpha = sin_cos((*theta)[2]), t_beta = sin_cos((*theta)[3]);
-  const Vec3 u0 = mount_.R * Vec3(t_beta.c, t_beta.s * t_alpha.c,
-                                  t_beta.s * t_alpha.s);
-  double psi = std::atan2(u0.cross(e).norm(), u0.dot(e));
+  const Vec3 u0 =
+      mount_.R * Vec3(t_beta.c, t_beta.s * t_alpha.c, t_beta.s * t_alpha.s);
   const double L = length_;
-  // g(psi) up to a constant, g', g''
-  auto cost = [&](double x, double* g1, double* g2) {
-    const SinCos sc = sin_cos(x);
-    const double o = x - psi_a;
-    if (contact_held) {
-      const double k = w_pos * L * dn;
-      if (g1 != nullptr) *g1 = 2.0 * (k * sc.s + w_ornt * o);
-      if (g2 != nullptr) *g2 = 2.0 * (k * sc.c + w_ornt);
-      return -2.0 * k * sc.c + w_ornt * o * o;
-    }
-    const double rn = h - L * sc.c;
-    if (g1 != nullptr) *g1 = 2.0 * (w_pos * rn * L * sc.s + w_ornt * o);
-    if (g2 != nullptr) {
-      *g2 = 2.0 * (w_pos * L * (L * sc.s * sc.s + rn * sc.c) + w_ornt);
-    }
-    return w_pos * rn * rn + w_ornt * o * o;
-  };
-  double g1 = 0.0, g2 = 0.0;
-  double g = cost(psi, &g1, &g2);
-  bool done = false;
-  for (int it = 0; it < 50 && !done; ++it) {
-    // Newton where g is convex, else a bounded descent step; halved until
-    // g does not increase; psi stays in [0, pi]
-    double step = g2 > 0.0 ? -g1 / g2 : (g1 > 0.0 ? -0.25 : 0.25);
-    step = std::clamp(step, -0.5, 0.5);
-    for (int half = 0; half < 40; ++half) {
-      const double x = std::clamp(psi + step, 0.0, kPi);
-      const double gx = cost(x, nullptr, nullptr);
-      if (gx <= g) {
-        done = std::abs(x - psi) < 1e-15 * (1.0 + std::abs(psi)) ||
-               std::abs(step) < 1e-13;
-        psi = x;
-        g = cost(psi, &g1, &g2);
-        break;
-      }
-      step *= 0.5;
-      if (half == 39) done = true;
-    }
-  }
+  const ProbeAngleCost cost{contact_held, w_pos, w_ornt, L, dn, h, psi_a};
+  const double psi =
+      minimise_probe_angle(cost, std::atan2(u0.cross(e).norm(), u0.dot(e)));
   if (!std::isfinite(psi)) return false;
   const SinCos sp = sin_cos(psi);
   const Vec3 u = sp.c * e + sp.s * t;
   surface_angles(mount_.R.transpose() * u, theta);
-  if (!contact_held) {
-    const Vec3 tip = rm.p - L * u - mount_.origin;
-    (*theta)[0] = mount_.R.col(0).dot(tip);
-    (*theta)[1] = mount_.R.col(1).dot(tip);
-  }
+  if (!contact_held) slide_under(mount_, L, rm.p, u, theta);
   normalize(theta);
   return true;
 }
