@@ -172,19 +172,12 @@ DeviceError SafetyLayer::read_joints(Joints* q_device_rad) noexcept {
   return joints_of_state(q_device_rad);
 }
 
-DeviceError SafetyLayer::read_state(DeviceState* state) noexcept {
-  status_ = kSafetyOk;
-  DeviceError err = inner_->read_state(state);
-  const Joints q = state->q_device_rad;
-  if (err == DeviceError::kOk && !q.allFinite()) err = DeviceError::kSensorFault;
-
-  // the time step since the last read: between the caller's stamps, else
-  // the device's own clock (a good reading's), else one servo period
+void SafetyLayer::advance_clock(bool good, const DeviceState& state) noexcept {
   double stamp_s = std::nan("");
   if (stamped_) {
     stamp_s = stamp_s_;
-  } else if (err == DeviceError::kOk && state->has(kStateTimestamp)) {
-    stamp_s = state->timestamp_s;
+  } else if (good && state.has(kStateTimestamp)) {
+    stamp_s = state.timestamp_s;
   }
   dt_s_ = params_.servo_period_s;
   if (std::isfinite(stamp_s)) {
@@ -192,24 +185,26 @@ DeviceError SafetyLayer::read_state(DeviceState* state) noexcept {
     last_stamp_s_ = stamp_s;
     have_stamp_ = true;
   }
-  // the motors held the last torque over the interval that just ended
-  update_heat(tau_prev_);
+}
 
-  if (err != DeviceError::kOk) {
-    state->present = 0;
-    have_reading_ = false;
-    have_previous_ = false;  // nothing to take a velocity from
-    good_reads_ = 0;
-    if (++failed_reads_ >= params_.comm_lost_reads) comm_lost_ = true;
-    if (comm_lost_) status_ |= kSafetyCommLost;
-    if (watchdog_fired_) status_ |= kSafetyWatchdogExpired;
-    return err;
-  }
+DeviceError SafetyLayer::lose_reading(DeviceError err,
+                                      DeviceState* state) noexcept {
+  state->present = 0;
+  have_reading_ = false;
+  have_previous_ = false;  // nothing to take a velocity from
+  good_reads_ = 0;
+  if (++failed_reads_ >= params_.comm_lost_reads) comm_lost_ = true;
+  if (comm_lost_) status_ |= kSafetyCommLost;
+  if (watchdog_fired_) status_ |= kSafetyWatchdogExpired;
+  return err;
+}
+
+void SafetyLayer::note_good_read(const DeviceState& state) noexcept {
   failed_reads_ = 0;
   // the switches, where the device reports them (set_inputs() otherwise)
-  if (state->has(kStateInkwell)) docked_ = state->docked;
-  if (state->has(kStateButtons) && params_.deadman_buttons != 0) {
-    deadman_ = (state->buttons & params_.deadman_buttons) != 0;
+  if (state.has(kStateInkwell)) docked_ = state.docked;
+  if (state.has(kStateButtons) && params_.deadman_buttons != 0) {
+    deadman_ = (state.buttons & params_.deadman_buttons) != 0;
   }
   // the ramp's clock: the time from the write that started it to this read
   if (ramp_running_) {
@@ -223,18 +218,9 @@ DeviceError SafetyLayer::read_state(DeviceState* state) noexcept {
   // the servo is ticking again: the watchdog's cut ends (the ramp restarts
   // because the watchdog zeroed the state)
   watchdog_fired_ = false;
+}
 
-  const Joints q_dh = device_to_dh_joints(q);
-  const Vec3 p_m = omni_fk(omni_, q_dh).p_base_m;
-  torque_to_force_ =
-      motor_torque_to_force_map(omni_, q, params_.singular_damping_m);
-  if (!torque_to_force_.allFinite()) {
-    // cannot happen for finite angles and l > 0; a cut is the safe answer
-    have_reading_ = false;
-    have_previous_ = false;
-    return DeviceError::kSensorFault;
-  }
-
+void SafetyLayer::measure_speeds(const Joints& q, const Vec3& p_m) noexcept {
   tip_speed_ = 0.0;
   joint_speed_ = 0.0;
   if (have_previous_) {
@@ -254,6 +240,33 @@ DeviceError SafetyLayer::read_state(DeviceState* state) noexcept {
     }
   }
   if (velocity_exceeded_) status_ |= kSafetyVelocityExceeded;
+}
+
+DeviceError SafetyLayer::read_state(DeviceState* state) noexcept {
+  status_ = kSafetyOk;
+  DeviceError err = inner_->read_state(state);
+  const Joints q = state->q_device_rad;
+  if (err == DeviceError::kOk && !q.allFinite()) err = DeviceError::kSensorFault;
+
+  advance_clock(err == DeviceError::kOk, *state);
+  // the motors held the last torque over the interval that just ended
+  update_heat(tau_prev_);
+
+  if (err != DeviceError::kOk) return lose_reading(err, state);
+  note_good_read(*state);
+
+  const Joints q_dh = device_to_dh_joints(q);
+  const Vec3 p_m = omni_fk(omni_, q_dh).p_base_m;
+  torque_to_force_ =
+      motor_torque_to_force_map(omni_, q, params_.singular_damping_m);
+  if (!torque_to_force_.allFinite()) {
+    // cannot happen for finite angles and l > 0; a cut is the safe answer
+    have_reading_ = false;
+    have_previous_ = false;
+    return DeviceError::kSensorFault;
+  }
+
+  measure_speeds(q, p_m);
   q_prev_ = q;
   p_prev_m_ = p_m;
   have_previous_ = true;

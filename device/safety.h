@@ -217,6 +217,19 @@ class SafetyLayer final : public HapticDevice {
   Vec3 force_device_N(const Vec3& tau_motor_Nm) const noexcept;
 
  private:
+  // read_state's steps. The time step since the last read, dt_s_: between
+  // the caller's stamps, else the device's own clock (a `good` reading's),
+  // else one servo period
+  void advance_clock(bool good, const DeviceState& state) noexcept;
+  // a failed read: no reading and no previous one to take a velocity from,
+  // one more failure toward comm_lost; returns err
+  DeviceError lose_reading(DeviceError err, DeviceState* state) noexcept;
+  // a good read: the switches where the device reports them, the ramp's
+  // clock, the link's recovery, the end of a watchdog cut
+  void note_good_read(const DeviceState& state) noexcept;
+  // the tip's and the joints' speeds since the previous reading (q device
+  // joints, p_m the wrist centre in m), and the velocity cut's latch
+  void measure_speeds(const Joints& q, const Vec3& p_m) noexcept;
   void cut_state() noexcept;
   double clamp_factor(const Vec3& tau) const noexcept;
   void update_heat(const Vec3& tau) noexcept;
