@@ -135,27 +135,30 @@ std::string read_regular_file(const std::string& path, std::uint64_t max_bytes,
   }
 }
 
-RecordingMeta parse_recording_meta(const Json& j, const std::string& path) {
-  if (!j.is_object()) {
-    throw RecordingError(path + ": not a JSON object (a recording's meta.json "
-                         "is one)");
-  }
-  const MetaChecker c(j, path);
-  RecordingMeta m;
-  m.json = j;
+namespace {
+
+// "verb": there, a string, and one of the verbs that write a recording
+std::string meta_verb(const MetaChecker& c, const Json& j,
+                      const std::string& path) {
   const Json* verb = MetaChecker::child(j, "verb");
   if (verb == nullptr) {
     throw RecordingError(path + ": no key 'verb' (not written by vmhaptics hw)");
   }
   if (!verb->is_string()) c.fail("verb", std::string("must be a string, not ") + verb->type_name());
-  m.verb = verb->get<std::string>();
+  std::string name = verb->get<std::string>();
   bool known = false;
-  for (const char* v : kRecordingVerbs) known |= m.verb == v;
+  for (const char* v : kRecordingVerbs) known |= name == v;
   if (!known) {
-    c.fail("verb", "'" + shown(m.verb) +
+    c.fail("verb", "'" + shown(name) +
                        "' is not a verb that writes a recording (hw record, hw "
                        "motor-test, hw run)");
   }
+  return name;
+}
+
+// "recording_format" (this reader's when absent), "software" (vmhaptics,
+// a version string) and "date_utc": what wrote the recording
+void check_writer(const MetaChecker& c, const Json& j) {
   const long long format = c.integer(j, "recording_format", "recording_format",
                                      0, 1'000'000, kRecordingFormat);
   if (format != kRecordingFormat) {
@@ -173,60 +176,99 @@ RecordingMeta parse_recording_meta(const Json& j, const std::string& path) {
     c.text(*s, "version", "software.version");
   }
   c.text(j, "date_utc", "date_utc");
+}
+
+// "device": the identity of the device recorded
+void read_device(const MetaChecker& c, const Json& d, DeviceIdentity* device) {
+  device->backend = c.text(d, "backend", "device.backend");
+  device->config = c.text(d, "config", "device.config");
+  device->model = c.text(d, "model", "device.model");
+  device->vendor = c.text(d, "vendor", "device.vendor");
+  device->serial = c.text(d, "serial", "device.serial");
+  device->driver_version = c.text(d, "driver_version", "device.driver_version");
+  device->firmware_version =
+      c.text(d, "firmware_version", "device.firmware_version");
+  device->api_version = c.text(d, "api_version", "device.api_version");
+  device->input_dof =
+      static_cast<int>(c.integer(d, "input_dof", "device.input_dof", 0, 6, 0));
+  device->output_dof = static_cast<int>(
+      c.integer(d, "output_dof", "device.output_dof", 0, 6, 0));
+}
+
+// "session": its duration, ticks and nominal period
+void read_session(const MetaChecker& c, const Json& s, RecordingMeta* m) {
+  m->duration_s = c.number(s, "duration_s", "session.duration_s", 0.0, 1e7);
+  c.integer(s, "ticks", "session.ticks", 0, 1'000'000'000'000LL, 0);
+  if (const Json* t = c.object(s, "timing", "session.timing")) {
+    const double us =
+        c.number(*t, "nominal_period_us", "session.timing.nominal_period_us",
+                 0.0, 1e6, true);
+    if (std::isfinite(us)) m->nominal_period_s = 1e-6 * us;
+  }
+}
+
+// the keys only one verb writes: refused in another verb's recording
+void check_verb_keys(const MetaChecker& c, const std::string& verb) {
+  c.only_for("motor", verb, "hw motor-test");
+  c.only_for("torque_asked_mNm", verb, "hw motor-test");
+  c.only_for("pulse_ms", verb, "hw motor-test");
+  c.only_for("sets", verb, "hw run");
+  c.only_for("gain_scale", verb, "hw run");
+  c.only_for("case", verb, "hw run");
+}
+
+// hw motor-test's keys: the motor pulsed (required), the torque asked for,
+// the pulse's length
+void read_motor_test(const MetaChecker& c, const Json& j, RecordingMeta* m) {
+  m->motor = static_cast<int>(c.integer(j, "motor", "motor", 1, 3, 0));
+  if (m->motor == 0) {
+    c.fail("motor", "missing: a motor test's meta.json names the motor it "
+                    "pulsed (1, 2 or 3)");
+  }
+  m->torque_asked_mNm =
+      c.number(j, "torque_asked_mNm", "torque_asked_mNm", -kHuge, kHuge);
+  m->pulse_ms = c.number(j, "pulse_ms", "pulse_ms", 0.0, 1e4, true);
+}
+
+// hw run's keys: the case, its scene, its --set overrides, the gain scale
+void read_run(const MetaChecker& c, const Json& j, RecordingMeta* m) {
+  m->case_name = c.text(j, "case", "case");
+  m->scene = c.text(j, "scene", "scene");
+  if (const Json* s = MetaChecker::child(j, "sets")) {
+    if (!s->is_array()) c.fail("sets", std::string("must be an array of strings, not ") + s->type_name());
+    for (std::size_t i = 0; i < s->size(); ++i) {
+      if (!(*s)[i].is_string()) {
+        c.fail("sets[" + std::to_string(i) + "]",
+               std::string("must be a string, not ") + (*s)[i].type_name());
+      }
+      m->sets.push_back((*s)[i].get<std::string>());
+    }
+  }
+  m->gain_scale = c.number(j, "gain_scale", "gain_scale", 0.0, kHuge);
+}
+
+}  // namespace
+
+RecordingMeta parse_recording_meta(const Json& j, const std::string& path) {
+  if (!j.is_object()) {
+    throw RecordingError(path + ": not a JSON object (a recording's meta.json "
+                         "is one)");
+  }
+  const MetaChecker c(j, path);
+  RecordingMeta m;
+  m.json = j;
+  m.verb = meta_verb(c, j, path);
+  check_writer(c, j);
   if (const Json* d = c.object(j, "device", "device")) {
-    m.device.backend = c.text(*d, "backend", "device.backend");
-    m.device.config = c.text(*d, "config", "device.config");
-    m.device.model = c.text(*d, "model", "device.model");
-    m.device.vendor = c.text(*d, "vendor", "device.vendor");
-    m.device.serial = c.text(*d, "serial", "device.serial");
-    m.device.driver_version = c.text(*d, "driver_version", "device.driver_version");
-    m.device.firmware_version =
-        c.text(*d, "firmware_version", "device.firmware_version");
-    m.device.api_version = c.text(*d, "api_version", "device.api_version");
-    m.device.input_dof =
-        static_cast<int>(c.integer(*d, "input_dof", "device.input_dof", 0, 6, 0));
-    m.device.output_dof =
-        static_cast<int>(c.integer(*d, "output_dof", "device.output_dof", 0, 6, 0));
+    read_device(c, *d, &m.device);
   }
   if (const Json* s = c.object(j, "session", "session")) {
-    m.duration_s = c.number(*s, "duration_s", "session.duration_s", 0.0, 1e7);
-    c.integer(*s, "ticks", "session.ticks", 0, 1'000'000'000'000LL, 0);
-    if (const Json* t = c.object(*s, "timing", "session.timing")) {
-      const double us = c.number(*t, "nominal_period_us",
-                                 "session.timing.nominal_period_us", 0.0, 1e6, true);
-      if (std::isfinite(us)) m.nominal_period_s = 1e-6 * us;
-    }
+    read_session(c, *s, &m);
   }
-  c.only_for("motor", m.verb, "hw motor-test");
-  c.only_for("torque_asked_mNm", m.verb, "hw motor-test");
-  c.only_for("pulse_ms", m.verb, "hw motor-test");
-  c.only_for("sets", m.verb, "hw run");
-  c.only_for("gain_scale", m.verb, "hw run");
-  c.only_for("case", m.verb, "hw run");
-  if (m.verb == "hw motor-test") {
-    m.motor = static_cast<int>(c.integer(j, "motor", "motor", 1, 3, 0));
-    if (m.motor == 0) {
-      c.fail("motor", "missing: a motor test's meta.json names the motor it "
-                      "pulsed (1, 2 or 3)");
-    }
-    m.torque_asked_mNm =
-        c.number(j, "torque_asked_mNm", "torque_asked_mNm", -kHuge, kHuge);
-    m.pulse_ms = c.number(j, "pulse_ms", "pulse_ms", 0.0, 1e4, true);
-  }
+  check_verb_keys(c, m.verb);
+  if (m.verb == "hw motor-test") read_motor_test(c, j, &m);
   if (m.verb == "hw run") {
-    m.case_name = c.text(j, "case", "case");
-    m.scene = c.text(j, "scene", "scene");
-    if (const Json* s = MetaChecker::child(j, "sets")) {
-      if (!s->is_array()) c.fail("sets", std::string("must be an array of strings, not ") + s->type_name());
-      for (std::size_t i = 0; i < s->size(); ++i) {
-        if (!(*s)[i].is_string()) {
-          c.fail("sets[" + std::to_string(i) + "]",
-                 std::string("must be a string, not ") + (*s)[i].type_name());
-        }
-        m.sets.push_back((*s)[i].get<std::string>());
-      }
-    }
-    m.gain_scale = c.number(j, "gain_scale", "gain_scale", 0.0, kHuge);
+    read_run(c, j, &m);
   } else if (MetaChecker::child(j, "scene") != nullptr) {
     c.text(j, "scene", "scene");
   }
