@@ -18,6 +18,9 @@
 //   LineVm    (vm_line.h)    - 1 DOF: a handle sliding on a straight line,
 //               the circle's limit as its radius grows (this project's
 //               addition, docs/control.md).
+// The circle and the sphere write once, in RevoluteVm (vm_revolute.h), what
+// follows from a link on revolute joints at the pivot: the pose, J_V and
+// the closed forms from the angles of one direction.
 //
 // Units: the mechanisms do not know about units. Every length (pivot, L,
 // positions, prismatic coordinates) is in one length unit chosen by the

@@ -12,12 +12,10 @@ namespace vmh {
 using namespace vm_detail;  // NOLINT(build/namespaces)
 using constants::kPi;
 
-CircleVm::CircleVm(const VmMount& mount, double length)
-    : VirtualMechanism(mount, length) {}
-
 namespace {
 
 VmPose circle_pose(const VmMount& mount, double length, double c, double s) {
+  // eq. 3.25/3.26 in the pivot frame, then into the device frame:
   // R rot_z(theta) column by column: rot_z mixes only the first two
   // columns, and the link axis R (c, s, 0) is the first of them, so neither
   // needs a 3 x 3 product
@@ -32,42 +30,12 @@ VmPose circle_pose(const VmMount& mount, double length, double c, double s) {
 
 void circle_jacobian(const VmMount& mount, double length, double c, double s,
                      VmJacobian* J) {
+  // eq. 3.27: (-L sin, L cos, 0, 0, 0, 1) in the pivot frame
   J->resize(6, 1);
   J->block<3, 1>(0, 0) = mount.R * Vec3(-length * s, length * c, 0.0);
   J->block<3, 1>(3, 0) = mount.R.col(2);
 }
 
-}  // namespace
-
-void CircleVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
-                             VmJacobian* J) const {
-  const SinCos t = sin_cos(theta[0]);
-  const double c = t.c, s = t.s;
-  *pose = circle_pose(mount_, length_, c, s);
-  circle_jacobian(mount_, length_, c, s, J);
-}
-
-Vec3 CircleVm::position(const VmAngles& theta) const {
-  const SinCos t = sin_cos(theta[0]);
-  const double c = t.c, s = t.s;
-  return mount_.origin + length_ * (mount_.R * Vec3(c, s, 0.0));
-}
-
-VmPose CircleVm::pose(const VmAngles& theta) const {
-  // eq. 3.25/3.26 in the pivot frame, then into the device frame
-  const SinCos t = sin_cos(theta[0]);
-  const double c = t.c, s = t.s;
-  return circle_pose(mount_, length_, c, s);
-}
-
-void CircleVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
-  // eq. 3.27: (-L sin, L cos, 0, 0, 0, 1) in the pivot frame
-  const SinCos t = sin_cos(theta[0]);
-  const double c = t.c, s = t.s;
-  circle_jacobian(mount_, length_, c, s, J);
-}
-
-namespace {
 // theta = atan2(y, x) (§3.3.1) for (x, y) off the origin; returns its sine
 // and cosine from (x, y) itself, which callers needing only the angle drop
 SinCos circle_angle(double x, double y, VmAngles* theta) {
@@ -75,45 +43,44 @@ SinCos circle_angle(double x, double y, VmAngles* theta) {
   const double inv = 1.0 / std::sqrt(x * x + y * y);
   return SinCos{y * inv, x * inv};
 }
+
 }  // namespace
 
-bool CircleVm::nearest(const RmPose& rm, VmAngles* theta) const {
-  // §3.3.1: theta_V = atan2(Y - Y0, X - X0), in the pivot frame
-  const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
-  if (!above(d.x(), d.y(), kDegenerateFraction * length_)) return false;
-  circle_angle(d.x(), d.y(), theta);
-  return true;
-}
+namespace vm_detail {
 
-bool CircleVm::aligned(const RmPose& rm, VmAngles* theta) const {
-  // §3.3.1: theta_R = atan2(Z_y, Z_x) of the stylus z axis
-  const Vec3 a = mount_.R.transpose() * rm.axis;
-  if (!above(a.x(), a.y(), kPoleSin)) return false;
-  circle_angle(a.x(), a.y(), theta);
-  return true;
-}
+// RevoluteVm's geometry of the circle: the one angle of a direction's
+// projection onto the plane, theta_V = atan2(Y - Y0, X - X0) of the wrist
+// centre and theta_R = atan2(Z_y, Z_x) of the stylus z axis (§3.3.1),
+// each undefined where the projection (almost) vanishes
+struct CircleGeometry {
+  using Trig = SinCos;
+  static constexpr PathPrimitive::Type kPath = PathPrimitive::Type::kCircle;
 
-bool CircleVm::nearest_pose_jacobian(const RmPose& rm, VmAngles* theta,
-                                     VmPose* pose, VmJacobian* J) const {
-  const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
-  if (!above(d.x(), d.y(), kDegenerateFraction * length_)) return false;
-  const SinCos t = circle_angle(d.x(), d.y(), theta);
-  *pose = circle_pose(mount_, length_, t.c, t.s);
-  circle_jacobian(mount_, length_, t.c, t.s, J);
-  return true;
-}
-
-bool CircleVm::aligned_position(const RmPose& rm, VmAngles* theta,
-                                Vec3* p) const {
-  const Vec3 a = mount_.R.transpose() * rm.axis;
-  if (!above(a.x(), a.y(), kPoleSin)) {
-    *p = position(*theta);
-    return false;
+  static Trig trig(const VmAngles& theta) { return sin_cos(theta[0]); }
+  static Trig angles(const Vec3& d, VmAngles* theta) {
+    return circle_angle(d.x(), d.y(), theta);
   }
-  const SinCos t = circle_angle(a.x(), a.y(), theta);
-  *p = mount_.origin + length_ * (mount_.R * Vec3(t.c, t.s, 0.0));
-  return true;
-}
+  static bool reaches(const Vec3& d, double length) {
+    return above(d.x(), d.y(), kDegenerateFraction * length);
+  }
+  static bool points(const Vec3& a) { return above(a.x(), a.y(), kPoleSin); }
+  static VmPose pose(const VmMount& mount, double length, const Trig& t,
+                     const VmAngles&) {
+    return circle_pose(mount, length, t.c, t.s);
+  }
+  static void jacobian(const VmMount& mount, double length, const Trig& t,
+                       VmJacobian* J) {
+    circle_jacobian(mount, length, t.c, t.s, J);
+  }
+  static Vec3 link(const Trig& t) { return Vec3(t.c, t.s, 0.0); }
+};
+
+}  // namespace vm_detail
+
+template class RevoluteVm<vm_detail::CircleGeometry>;
+
+CircleVm::CircleVm(const VmMount& mount, double length)
+    : RevoluteVm(mount, length) {}
 
 Vec3 CircleVm::thesis_orientation_error(const VmAngles& theta_v,
                                         const VmAngles& theta_r) const {
@@ -139,28 +106,17 @@ void CircleVm::normalize(VmAngles* theta) const {
   (*theta)[0] = wrap_angle((*theta)[0]);
 }
 
-
 double CircleVm::distance_to_path(const Vec3& p) const {
-  const Vec3 r = mount_.R.transpose() * (p - mount_.origin);
+  const Vec3 r = from_pivot(p);
   const double rho = std::hypot(r.x(), r.y());
   return std::hypot(rho - length_, r.z());
 }
 
 Vec3 CircleVm::nearest_on_path(const Vec3& p) const {
-  Vec3 r = mount_.R.transpose() * (p - mount_.origin);
+  Vec3 r = from_pivot(p);
   r.z() = 0.0;
   if (r.norm() < 1e-12) return mount_.origin;
   return mount_.origin + mount_.R * (length_ * r.normalized());
-}
-
-std::vector<PathPrimitive> CircleVm::path_primitives() const {
-  PathPrimitive circle;
-  circle.type = PathPrimitive::Type::kCircle;
-  circle.centre = mount_.origin;
-  circle.u = mount_.R.col(0);
-  circle.v = mount_.R.col(1);
-  circle.radius = length_;
-  return {circle};
 }
 
 bool CircleVm::path_start(const Vec3& dir, PathStart* out) const {

@@ -6,37 +6,31 @@
 #define VMHAPTICS_CONTROLLER_VM_CIRCLE_H_
 
 #include "controller/virtual_mechanism.h"
+#include "controller/vm_revolute.h"
 
 namespace vmh {
 
-class CircleVm final : public VirtualMechanism {
+namespace vm_detail {
+struct CircleGeometry;  // vm_circle.cc
+}  // namespace vm_detail
+extern template class RevoluteVm<vm_detail::CircleGeometry>;
+
+// The pose, J_V, the closed forms and the path's drawing: RevoluteVm's,
+// from the link's angle in the plane
+class CircleVm final : public RevoluteVm<vm_detail::CircleGeometry> {
  public:
   CircleVm(const VmMount& mount, double length);
   VmKind kind() const override { return VmKind::kCircle; }
   int dof() const override { return 1; }
-  VmPose pose(const VmAngles& theta) const override;
-  void jacobian(const VmAngles& theta, VmJacobian* J) const override;
-  void pose_jacobian(const VmAngles& theta, VmPose* pose,
-                     VmJacobian* J) const override;
-  Vec3 position(const VmAngles& theta) const override;
-  bool nearest(const RmPose& rm, VmAngles* theta) const override;
-  bool aligned(const RmPose& rm, VmAngles* theta) const override;
-  bool nearest_pose_jacobian(const RmPose& rm, VmAngles* theta, VmPose* pose,
-                             VmJacobian* J) const override;
-  bool nearest_minimises_distance() const override { return true; }
-  bool aligned_position(const RmPose& rm, VmAngles* theta,
-                        Vec3* p) const override;
   Vec3 thesis_orientation_error(const VmAngles& theta_v,
                                 const VmAngles& theta_r) const override;
   Vec3 geometric_orientation_error(const VmPose& vm, const RmPose& rm,
                                    bool* ambiguous) const override;
   Mat3 orientation_error_jacobian(const VmPose& vm,
                                   const RmPose& rm) const override;
-  bool is_revolute(int) const override { return true; }
   void normalize(VmAngles* theta) const override;
   double distance_to_path(const Vec3& p) const override;
   Vec3 nearest_on_path(const Vec3& p) const override;
-  std::vector<PathPrimitive> path_primitives() const override;
   bool planar() const override { return true; }
   bool path_start(const Vec3& dir, PathStart* out) const override;
 };

@@ -12,9 +12,6 @@ namespace vmh {
 using namespace vm_detail;  // NOLINT(build/namespaces)
 using constants::kPi;
 
-SphereVm::SphereVm(const VmMount& mount, double length)
-    : VirtualMechanism(mount, length) {}
-
 namespace {
 
 struct SphereTrig {
@@ -57,31 +54,6 @@ void sphere_jacobian(const VmMount& mount, double L, const SphereTrig& t,
   J->bottomRows<3>() = mount.R * Jl.bottomRows<3>();
 }
 
-}  // namespace
-
-Vec3 SphereVm::position(const VmAngles& theta) const {
-  // the link axis, column 3 of eq. 3.29's rotation: no twist needed
-  const SphereTrig t(theta);
-  return mount_.origin +
-         length_ * (mount_.R * Vec3(t.c1 * t.s2, t.s1 * t.s2, -t.c2));
-}
-
-VmPose SphereVm::pose(const VmAngles& theta) const {
-  return sphere_pose(mount_, length_, SphereTrig(theta), theta[2]);
-}
-
-void SphereVm::jacobian(const VmAngles& theta, VmJacobian* J) const {
-  sphere_jacobian(mount_, length_, SphereTrig(theta), J);
-}
-
-void SphereVm::pose_jacobian(const VmAngles& theta, VmPose* pose,
-                             VmJacobian* J) const {
-  const SphereTrig t(theta);
-  *pose = sphere_pose(mount_, length_, t, theta[2]);
-  sphere_jacobian(mount_, length_, t, J);
-}
-
-namespace {
 // Polar angle from -z and azimuth of a direction d (pivot frame, any length
 // > 0): theta2 = pi - acos(d_z/|d|) = atan2(|d_xy|, -d_z) (§3.4.1), theta1 =
 // atan2(d_y, d_x); on the pole axis theta1 is left as it was. Both atan2s
@@ -106,50 +78,47 @@ SphereTrig sphere_angles(const Vec3& d, VmAngles* theta) {
 }
 }  // namespace
 
-bool SphereVm::nearest(const RmPose& rm, VmAngles* theta) const {
-  const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
-  // §3.4.1's LL = |d|, compared squared
-  if (!(d.squaredNorm() > kDegenerateFraction * kDegenerateFraction *
-                              length_ * length_)) {
-    return false;
+namespace vm_detail {
+
+// RevoluteVm's geometry of the sphere: the azimuth and polar angle of a
+// direction (§3.4.1), the twist kept; nearest() is undefined for the wrist
+// centre (almost) at the pivot (§3.4.1's LL = |d|, compared squared),
+// aligned() for a stylus axis of (almost) no length
+struct SphereGeometry {
+  using Trig = SphereTrig;
+  static constexpr PathPrimitive::Type kPath = PathPrimitive::Type::kSphere;
+
+  static Trig trig(const VmAngles& theta) { return SphereTrig(theta); }
+  static Trig angles(const Vec3& d, VmAngles* theta) {
+    return sphere_angles(d, theta);
   }
-  sphere_angles(d, theta);
-  return true;
-}
-
-bool SphereVm::aligned(const RmPose& rm, VmAngles* theta) const {
-  const Vec3 a = mount_.R.transpose() * rm.axis;
-  if (!(a.squaredNorm() > kPoleSin * kPoleSin)) return false;
-  sphere_angles(a, theta);
-  return true;
-}
-
-
-bool SphereVm::nearest_pose_jacobian(const RmPose& rm, VmAngles* theta,
-                                     VmPose* pose, VmJacobian* J) const {
-  const Vec3 d = mount_.R.transpose() * (rm.p - mount_.origin);
-  if (!(d.squaredNorm() > kDegenerateFraction * kDegenerateFraction *
-                              length_ * length_)) {
-    return false;
+  static bool reaches(const Vec3& d, double length) {
+    return d.squaredNorm() >
+           kDegenerateFraction * kDegenerateFraction * length * length;
   }
-  const SphereTrig t = sphere_angles(d, theta);
-  *pose = sphere_pose(mount_, length_, t, (*theta)[2]);
-  sphere_jacobian(mount_, length_, t, J);
-  return true;
-}
-
-bool SphereVm::aligned_position(const RmPose& rm, VmAngles* theta,
-                                Vec3* p) const {
-  const Vec3 a = mount_.R.transpose() * rm.axis;
-  if (!(a.squaredNorm() > kPoleSin * kPoleSin)) {
-    *p = position(*theta);
-    return false;
+  static bool points(const Vec3& a) {
+    return a.squaredNorm() > kPoleSin * kPoleSin;
   }
-  const SphereTrig t = sphere_angles(a, theta);
-  *p = mount_.origin +
-       length_ * (mount_.R * Vec3(t.c1 * t.s2, t.s1 * t.s2, -t.c2));
-  return true;
-}
+  static VmPose pose(const VmMount& mount, double length, const Trig& t,
+                     const VmAngles& theta) {
+    return sphere_pose(mount, length, t, theta[2]);
+  }
+  static void jacobian(const VmMount& mount, double length, const Trig& t,
+                       VmJacobian* J) {
+    sphere_jacobian(mount, length, t, J);
+  }
+  // column 3 of eq. 3.29's rotation
+  static Vec3 link(const Trig& t) {
+    return Vec3(t.c1 * t.s2, t.s1 * t.s2, -t.c2);
+  }
+};
+
+}  // namespace vm_detail
+
+template class RevoluteVm<vm_detail::SphereGeometry>;
+
+SphereVm::SphereVm(const VmMount& mount, double length)
+    : RevoluteVm(mount, length) {}
 
 Vec3 SphereVm::thesis_orientation_error(const VmAngles& theta_v,
                                         const VmAngles& theta_r) const {
@@ -172,26 +141,15 @@ void SphereVm::normalize(VmAngles* theta) const {
   (*theta)[2] = wrap_angle((*theta)[2]);
 }
 
-
 double SphereVm::distance_to_path(const Vec3& p) const {
-  const Vec3 r = mount_.R.transpose() * (p - mount_.origin);
+  const Vec3 r = from_pivot(p);
   return std::abs(r.norm() - length_);
 }
 
 Vec3 SphereVm::nearest_on_path(const Vec3& p) const {
-  const Vec3 r = mount_.R.transpose() * (p - mount_.origin);
+  const Vec3 r = from_pivot(p);
   if (r.norm() < 1e-12) return mount_.origin;
   return mount_.origin + mount_.R * (length_ * r.normalized());
-}
-
-std::vector<PathPrimitive> SphereVm::path_primitives() const {
-  PathPrimitive sphere;
-  sphere.type = PathPrimitive::Type::kSphere;
-  sphere.centre = mount_.origin;
-  sphere.u = mount_.R.col(0);
-  sphere.v = mount_.R.col(1);
-  sphere.radius = length_;
-  return {sphere};
 }
 
 bool predict_sphere(const VirtualMechanism& vm, const RmPose& rm,

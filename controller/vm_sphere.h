@@ -6,33 +6,27 @@
 #define VMHAPTICS_CONTROLLER_VM_SPHERE_H_
 
 #include "controller/virtual_mechanism.h"
+#include "controller/vm_revolute.h"
 
 namespace vmh {
 
-class SphereVm final : public VirtualMechanism {
+namespace vm_detail {
+struct SphereGeometry;  // vm_sphere.cc
+}  // namespace vm_detail
+extern template class RevoluteVm<vm_detail::SphereGeometry>;
+
+// The pose, J_V, the closed forms and the path's drawing: RevoluteVm's,
+// from the link's azimuth and polar angle (and the twist, for the pose)
+class SphereVm final : public RevoluteVm<vm_detail::SphereGeometry> {
  public:
   SphereVm(const VmMount& mount, double length);
   VmKind kind() const override { return VmKind::kSphere; }
   int dof() const override { return 3; }
-  VmPose pose(const VmAngles& theta) const override;
-  void jacobian(const VmAngles& theta, VmJacobian* J) const override;
-  void pose_jacobian(const VmAngles& theta, VmPose* pose,
-                     VmJacobian* J) const override;
-  Vec3 position(const VmAngles& theta) const override;
-  bool nearest(const RmPose& rm, VmAngles* theta) const override;
-  bool aligned(const RmPose& rm, VmAngles* theta) const override;
-  bool nearest_pose_jacobian(const RmPose& rm, VmAngles* theta, VmPose* pose,
-                             VmJacobian* J) const override;
-  bool nearest_minimises_distance() const override { return true; }
-  bool aligned_position(const RmPose& rm, VmAngles* theta,
-                        Vec3* p) const override;
   Vec3 thesis_orientation_error(const VmAngles& theta_v,
                                 const VmAngles& theta_r) const override;
-  bool is_revolute(int) const override { return true; }
   void normalize(VmAngles* theta) const override;
   double distance_to_path(const Vec3& p) const override;
   Vec3 nearest_on_path(const Vec3& p) const override;
-  std::vector<PathPrimitive> path_primitives() const override;
 };
 
 // The registry's prediction hook (VmPredictFn): the nearest point and the
