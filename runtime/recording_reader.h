@@ -13,8 +13,9 @@
 //   - the header's columns named and each named once, t_s among them;
 //   - every row complete (a last row cut short by a crash, without its
 //     line end, is dropped), t_s finite and strictly increasing;
-//   - meta.json an object that matches the recording schema below, from a
-//     verb that writes recordings and a format this reader knows.
+//   - meta.json an object that matches the recording schema
+//     (runtime/recording_meta.h), from a verb that writes recordings and a
+//     format this reader knows.
 //
 // Every refusal is a RecordingError whose one-line message names the file,
 // the line and column (or the JSON key) and what was wrong. Pure: files
@@ -31,13 +32,9 @@
 
 #include "device/device_backend.h"
 #include "runtime/json_util.h"
+#include "runtime/recording_meta.h"
 
 namespace vmh::runtime {
-
-// What meta.json's "recording_format" says (runtime/meta.cc writes it). A
-// meta.json without the key predates it and is read as format 1, the
-// layout it has; any other value is refused.
-inline constexpr int kRecordingFormat = 1;
 
 // The bounds a recording is read within. The defaults admit an hour at
 // 1 kHz with every optional column group (about 1.3 kB a row).
@@ -70,49 +67,6 @@ std::string read_regular_file(const std::string& path, std::uint64_t max_bytes,
                               bool* missing);
 
 // ---- meta.json -------------------------------------------------------------
-
-// The verbs whose sessions write a recording
-inline constexpr const char* kRecordingVerbs[] = {"hw record", "hw motor-test",
-                                                  "hw run"};
-
-// meta.json after validation. The schema (every key optional unless said;
-// a key that is there must have its type and range; other keys, such as a
-// backend's own entries, are kept in `json` unread):
-//   verb               required; one of kRecordingVerbs
-//   recording_format   integer; kRecordingFormat
-//   software           object; name "vmhaptics", version a string
-//   date_utc           string
-//   device             object; backend, config, model, vendor, serial,
-//                      driver_version, firmware_version, api_version
-//                      strings; input_dof, output_dof integers 0..6
-//   session            object; duration_s finite >= 0, ticks integer >= 0,
-//                      timing.nominal_period_us finite in (0, 1e6]
-//   motor              "hw motor-test" only, and required there: 1, 2 or 3
-//   torque_asked_mNm   "hw motor-test" only: finite
-//   pulse_ms           "hw motor-test" only: finite in (0, 1e4]
-//   case, scene        "hw run" only: strings
-//   sets               "hw run" only: an array of strings
-//   gain_scale         "hw run" only: finite and >= 0
-//   emulator           object; scene and hand strings (or null)
-struct RecordingMeta {
-  std::string verb;
-  DeviceIdentity device;
-  double duration_s = std::numeric_limits<double>::quiet_NaN();
-  double nominal_period_s = 0.0;  // 0 when not known
-  int motor = 0;                  // 1..3 for a motor test, else 0
-  double torque_asked_mNm = std::numeric_limits<double>::quiet_NaN();
-  double pulse_ms = std::numeric_limits<double>::quiet_NaN();
-  std::string case_name;          // hw run
-  std::string scene;              // hw run: the case's scene
-  std::vector<std::string> sets;  // hw run: its --set overrides
-  double gain_scale = std::numeric_limits<double>::quiet_NaN();  // hw run
-  std::string emulator_scene;     // the scene an emulator simulated, or ""
-  Json json;                      // meta.json as written
-};
-
-// Validates a parsed meta.json against the schema; `path` names the file
-// in messages ("<path>: key 'motor': 99 is not 1, 2 or 3").
-RecordingMeta parse_recording_meta(const Json& j, const std::string& path);
 
 // Reads and validates folder/meta.json. Throws RecordingError; *missing =
 // true (and an empty meta) when the file is not there.
