@@ -29,6 +29,9 @@ struct Projection {
   std::string title;  // shown under the panel's title
   Vec3 a, b;
   std::string xlabel, ylabel;
+  // a device-frame point's horizontal and vertical coordinates (mm)
+  double u(const Vec3& p) const { return a.dot(p); }
+  double v(const Vec3& p) const { return b.dot(p); }
 };
 
 struct Snapshot {
@@ -82,33 +85,29 @@ VmPath path_of(const VmParams& vm) {
                     vm.R_pivot);
 }
 
-void view_panel(Svg& svg, double ox, double oy, const std::string& name,
-                const Snapshot& snap, const Projection& proj,
-                const std::vector<TickRecord>& rows, const VmParams& vm) {
-  const std::string tag =
-      std::string(snap.tag) + (proj.tag.empty() ? "" : "-" + proj.tag);
-  auto u = [&](const Vec3& p) { return proj.a.dot(p); };
-  auto v = [&](const Vec3& p) { return proj.b.dot(p); };
+// What a view must show, in its own coordinates (mm): the pivot, the path
+// (a circle or sphere whole, a line L to either side of its centre, a
+// plane's handle path where it is edge-on), the RM's trail and, at the
+// snapshot, p, X(theta_V), X(theta_R), the stylus tip and the force's tip.
+// Both empty when nothing is finite.
+void view_extent(const Projection& proj, const std::vector<PathPrimitive>& path,
+                 const std::vector<TickRecord>& rows,
+                 const std::vector<std::size_t>& idx, const TickRecord* r,
+                 const VmParams& vm, Bounds* bu, Bounds* bv) {
   const double L = vm.length_mm;
-  // the path as the mechanism draws it (its drawing hook), mm
-  const std::vector<PathPrimitive> path = path_of(vm).primitives;
-  const std::vector<std::size_t> idx = decimated(rows.size());
-
-  // what must be in view
-  Bounds bu, bv;
   auto add = [&](const Vec3& p) {
-    bu.add(u(p));
-    bv.add(v(p));
+    bu->add(proj.u(p));
+    bv->add(proj.v(p));
   };
   add(vm.pivot_mm);
   for (const PathPrimitive& prim : path) {
     switch (prim.type) {
       case PathPrimitive::Type::kCircle:
       case PathPrimitive::Type::kSphere:
-        bu.add(u(prim.centre) - prim.radius);
-        bu.add(u(prim.centre) + prim.radius);
-        bv.add(v(prim.centre) - prim.radius);
-        bv.add(v(prim.centre) + prim.radius);
+        bu->add(proj.u(prim.centre) - prim.radius);
+        bu->add(proj.u(prim.centre) + prim.radius);
+        bv->add(proj.v(prim.centre) - prim.radius);
+        bv->add(proj.v(prim.centre) + prim.radius);
         break;
       case PathPrimitive::Type::kLine:
         add(prim.centre + L * prim.u);
@@ -123,7 +122,6 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
     }
   }
   for (std::size_t i : idx) add(rows[i].out.p_rm_mm);
-  const TickRecord* r = snap.row;
   if (r != nullptr) {
     const ControlOutput& o = r->out;
     add(o.p_rm_mm);
@@ -132,12 +130,16 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
     add(o.p_rm_mm + kPlotStylusMm * o.axis_rm);
     add(o.p_rm_mm + kPlotForceMmPerN * o.force_device_N);
   }
+}
+
+// The panel's plot area at (ox, oy): a square of whole ticks around the
+// extent (L to either side of 0 when it is empty), with an 8 mm margin
+// and at least 10 mm across.
+Frame view_frame(double ox, double oy, Bounds bu, Bounds bv, double L) {
   if (bu.empty() || bv.empty()) {
     bu = Bounds{-L, L};
     bv = Bounds{-L, L};
   }
-
-  // a square of whole ticks around it, with a margin
   const double pad = 8.0;
   const double span = std::max({bu.hi - bu.lo, bv.hi - bv.lo, 10.0}) + 2 * pad;
   const double step = nice_step(span, 6.0);
@@ -161,8 +163,14 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
   f.ylo = static_cast<double>(v0) * step;
   f.yhi = static_cast<double>(v1) * step;
   f.xstep = f.ystep = step;
+  return f;
+}
 
-  svg.open("g", attr("class", "panel") + attr("id", "panel-" + tag));
+// The panel's two title lines (the case, the snapshot with its time and
+// distance to the path, or why there is none; the view) and its axes.
+void view_titles(Svg& svg, const Frame& f, double oy, const std::string& name,
+                 const Snapshot& snap, const Projection& proj) {
+  const TickRecord* r = snap.row;
   std::string title = name + ": " + snap.what;
   if (r != nullptr) {
     title += " (t = " + format("%.3f", r->t_s) + " s, d = " +
@@ -175,10 +183,16 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
                proj.title,
            attr("fill", "#444"));
   draw_axes(svg, f, proj.xlabel, proj.ylabel, true);
+}
 
-  svg.clip_rect("clip-" + tag, f.left, f.top, f.width, f.height);
-  svg.open("g", attr("clip-path", "url(#clip-" + tag + ")"));
-  const double pu = u(vm.pivot_mm), pv = v(vm.pivot_mm);
+// The VM's path as its drawing hook gives it, the RM's trail over the run
+// (decimated rows `idx`) and the pivot's cross.
+void view_path_and_trail(Svg& svg, const Frame& f, const Projection& proj,
+                         const std::vector<PathPrimitive>& path,
+                         const std::vector<TickRecord>& rows,
+                         const std::vector<std::size_t>& idx,
+                         const VmParams& vm, const std::string& tag) {
+  const double pu = proj.u(vm.pivot_mm), pv = proj.v(vm.pivot_mm);
   PathView view;
   view.a = proj.a;
   view.b = proj.b;
@@ -194,40 +208,70 @@ void view_panel(Svg& svg, double ox, double oy, const std::string& name,
   std::vector<Pt> trail;
   trail.reserve(idx.size());
   for (std::size_t i : idx) {
-    trail.push_back(f.at(u(rows[i].out.p_rm_mm), v(rows[i].out.p_rm_mm)));
+    trail.push_back(
+        f.at(proj.u(rows[i].out.p_rm_mm), proj.v(rows[i].out.p_rm_mm)));
   }
   svg.polyline(trail, attr("stroke", "#a8a8a8") + attr("stroke-width", "0.8"));
   // the pivot
   svg.line(f.X(pu) - 4, f.Y(pv), f.X(pu) + 4, f.Y(pv), attr("stroke", "#000"));
   svg.line(f.X(pu), f.Y(pv) - 4, f.X(pu), f.Y(pv) + 4, attr("stroke", "#000"));
+}
 
-  if (r != nullptr) {
-    const ControlOutput& o = r->out;
-    const Vec3& p = o.p_rm_mm;
-    svg.line(f.X(pu), f.Y(pv), f.X(u(o.x_v_mm)), f.Y(v(o.x_v_mm)),
-             attr("id", "xv-" + tag) + attr("stroke", "#d00000") +
-                 attr("stroke-width", "2"));
-    svg.circle(f.X(u(o.x_v_mm)), f.Y(v(o.x_v_mm)), 2.5, attr("fill", "#d00000"));
-    svg.line(f.X(pu), f.Y(pv), f.X(u(o.x_r_mm)), f.Y(v(o.x_r_mm)),
-             attr("id", "xr-" + tag) + attr("stroke", "#00a000") +
-                 attr("stroke-width", "2"));
-    svg.circle(f.X(u(o.x_r_mm)), f.Y(v(o.x_r_mm)), 2.5, attr("fill", "#00a000"));
-    const Vec3 tip = p + kPlotStylusMm * o.axis_rm;
-    svg.line(f.X(u(p)), f.Y(v(p)), f.X(u(tip)), f.Y(v(tip)),
-             attr("id", "stylus-" + tag) + attr("stroke", "#000") +
-                 attr("stroke-width", "3") + attr("stroke-linecap", "round"));
-    // the force and its components in this view
-    const Vec3 F = kPlotForceMmPerN * o.force_device_N;
-    const std::string thin = attr("stroke", "#c000c0") +
-                             attr("stroke-width", "1") +
-                             attr("stroke-dasharray", "3 2");
-    svg.line(f.X(u(p)), f.Y(v(p)), f.X(u(p) + u(F)), f.Y(v(p)), thin);
-    svg.line(f.X(u(p)), f.Y(v(p)), f.X(u(p)), f.Y(v(p) + v(F)), thin);
-    arrow(svg, f.X(u(p)), f.Y(v(p)), f.X(u(p) + u(F)), f.Y(v(p) + v(F)),
-          "#c000c0", attr("id", "force-" + tag));
-    svg.circle(f.X(u(p)), f.Y(v(p)), 3.0,
-               attr("id", "p-" + tag) + attr("fill", "#000"));
-  }
+// The snapshot's tick: pivot -> X(theta_V) in red and pivot -> X(theta_R)
+// in green, the stylus axis at p, the force from p (kPlotForceMmPerN mm per
+// N) with its two components in this view dashed, and p.
+void view_snapshot(Svg& svg, const Frame& f, const Projection& proj,
+                   const ControlOutput& o, const VmParams& vm,
+                   const std::string& tag) {
+  auto u = [&](const Vec3& p) { return proj.u(p); };
+  auto v = [&](const Vec3& p) { return proj.v(p); };
+  const double pu = u(vm.pivot_mm), pv = v(vm.pivot_mm);
+  const Vec3& p = o.p_rm_mm;
+  svg.line(f.X(pu), f.Y(pv), f.X(u(o.x_v_mm)), f.Y(v(o.x_v_mm)),
+           attr("id", "xv-" + tag) + attr("stroke", "#d00000") +
+               attr("stroke-width", "2"));
+  svg.circle(f.X(u(o.x_v_mm)), f.Y(v(o.x_v_mm)), 2.5, attr("fill", "#d00000"));
+  svg.line(f.X(pu), f.Y(pv), f.X(u(o.x_r_mm)), f.Y(v(o.x_r_mm)),
+           attr("id", "xr-" + tag) + attr("stroke", "#00a000") +
+               attr("stroke-width", "2"));
+  svg.circle(f.X(u(o.x_r_mm)), f.Y(v(o.x_r_mm)), 2.5, attr("fill", "#00a000"));
+  const Vec3 tip = p + kPlotStylusMm * o.axis_rm;
+  svg.line(f.X(u(p)), f.Y(v(p)), f.X(u(tip)), f.Y(v(tip)),
+           attr("id", "stylus-" + tag) + attr("stroke", "#000") +
+               attr("stroke-width", "3") + attr("stroke-linecap", "round"));
+  // the force and its components in this view
+  const Vec3 F = kPlotForceMmPerN * o.force_device_N;
+  const std::string thin = attr("stroke", "#c000c0") +
+                           attr("stroke-width", "1") +
+                           attr("stroke-dasharray", "3 2");
+  svg.line(f.X(u(p)), f.Y(v(p)), f.X(u(p) + u(F)), f.Y(v(p)), thin);
+  svg.line(f.X(u(p)), f.Y(v(p)), f.X(u(p)), f.Y(v(p) + v(F)), thin);
+  arrow(svg, f.X(u(p)), f.Y(v(p)), f.X(u(p) + u(F)), f.Y(v(p) + v(F)),
+        "#c000c0", attr("id", "force-" + tag));
+  svg.circle(f.X(u(p)), f.Y(v(p)), 3.0,
+             attr("id", "p-" + tag) + attr("fill", "#000"));
+}
+
+// One view of one snapshot at (ox, oy): its extent, frame and titles, then
+// the path, the trail and the snapshot's vectors clipped to the frame.
+void view_panel(Svg& svg, double ox, double oy, const std::string& name,
+                const Snapshot& snap, const Projection& proj,
+                const std::vector<TickRecord>& rows, const VmParams& vm) {
+  const std::string tag =
+      std::string(snap.tag) + (proj.tag.empty() ? "" : "-" + proj.tag);
+  // the path as the mechanism draws it (its drawing hook), mm
+  const std::vector<PathPrimitive> path = path_of(vm).primitives;
+  const std::vector<std::size_t> idx = decimated(rows.size());
+  Bounds bu, bv;
+  view_extent(proj, path, rows, idx, snap.row, vm, &bu, &bv);
+  const Frame f = view_frame(ox, oy, bu, bv, vm.length_mm);
+
+  svg.open("g", attr("class", "panel") + attr("id", "panel-" + tag));
+  view_titles(svg, f, oy, name, snap, proj);
+  svg.clip_rect("clip-" + tag, f.left, f.top, f.width, f.height);
+  svg.open("g", attr("clip-path", "url(#clip-" + tag + ")"));
+  view_path_and_trail(svg, f, proj, path, rows, idx, vm, tag);
+  if (snap.row != nullptr) view_snapshot(svg, f, proj, snap.row->out, vm, tag);
   svg.close("g");
   svg.close("g");
 }
@@ -300,6 +344,148 @@ struct HistoryPanel {
   std::vector<Series> series;
 };
 
+struct HistoryLayout {
+  static constexpr double kLeft = 76.0;  // room for y numbers, label
+  static constexpr double kPlotW = 800.0;
+  static constexpr double kPlotH = 180.0;
+  static constexpr double kGap = 22.0;   // between panels
+  static constexpr double kTop = 58.0;   // title and segment names
+  static constexpr double kLegendX = kLeft + kPlotW + 22.0;
+  static constexpr double kWidth = kLegendX + 230.0;
+  static constexpr double kHeight = kTop + 3.0 * kPlotH + 2.0 * kGap + 52.0;
+};
+
+// The three panels: (a) p - X(theta_V) per axis with the distance to the
+// path, (b) p - X(theta_R) per axis, (c) the commanded force per axis and
+// its magnitude.
+std::vector<HistoryPanel> history_panels() {
+  const char* const kColor[3] = {"#d62728", "#2ca02c", "#1f77b4"};
+  const char* const kAxis[3] = {"x", "y", "z"};
+  std::vector<HistoryPanel> panels(3);
+  panels[0].ylabel = "(a) p - X(theta_V) (mm)";
+  panels[0].heading = "(a) p - X(theta_V) (mm)";
+  panels[1].ylabel = "(b) p - X(theta_R) (mm)";
+  panels[1].heading = "(b) p - X(theta_R) (mm)";
+  panels[2].ylabel = "(c) force F (N)";
+  panels[2].heading = "(c) commanded force (N)";
+  for (int i = 0; i < 3; ++i) {
+    const std::string c = kAxis[i];
+    panels[0].series.push_back({c, kColor[i], "", [i](const TickRecord& r) {
+                                  return r.out.p_rm_mm[i] - r.out.x_v_mm[i];
+                                }});
+    panels[1].series.push_back({c, kColor[i], "", [i](const TickRecord& r) {
+                                  return r.out.p_rm_mm[i] - r.out.x_r_mm[i];
+                                }});
+    panels[2].series.push_back({"F_" + c, kColor[i], "", [i](const TickRecord& r) {
+                                  return r.out.force_device_N[i];
+                                }});
+  }
+  panels[0].series.push_back({"d_path (distance to the path)", "#000", "5 3",
+                              [](const TickRecord& r) { return r.d_path_mm; }});
+  panels[2].series.push_back({"|F|", "#000", "5 3", [](const TickRecord& r) {
+                                return r.out.force_device_N.norm();
+                              }});
+  return panels;
+}
+
+// The time axis the panels share: the run's first to last tick (1 ms at
+// least), with ticks about a tenth of it apart, ending on a tick when the
+// run nearly does (the last tick is at T - period). Only xlo, xhi and xstep
+// are set.
+Frame history_time_axis(const std::vector<TickRecord>& rows) {
+  double t0 = rows.front().t_s, t1 = rows.back().t_s;
+  if (!(t1 > t0)) t1 = t0 + 1e-3;
+  const double tstep = nice_step(t1 - t0, 10.0);
+  const double t_end = static_cast<double>(step_index_up(t1, tstep)) * tstep;
+  if (t_end - t1 < 0.02 * (t1 - t0)) t1 = t_end;
+  Frame f;
+  f.xlo = t0;
+  f.xhi = t1;
+  f.xstep = tstep;
+  return f;
+}
+
+// Panel k's plot area on the shared time axis: y over its series' values
+// at the decimated rows `idx` and 0, with a 5% margin, on whole ticks.
+Frame history_frame(const Frame& time, std::size_t k, const HistoryPanel& hp,
+                    const std::vector<TickRecord>& rows,
+                    const std::vector<std::size_t>& idx) {
+  Frame f = time;
+  f.left = HistoryLayout::kLeft;
+  const double pitch = HistoryLayout::kPlotH + HistoryLayout::kGap;
+  f.top = HistoryLayout::kTop + static_cast<double>(k) * pitch;
+  f.width = HistoryLayout::kPlotW;
+  f.height = HistoryLayout::kPlotH;
+  Bounds b;
+  b.add(0.0);
+  for (const Series& s : hp.series) {
+    for (std::size_t i : idx) b.add(s.value(rows[i]));
+  }
+  if (b.hi - b.lo < 1e-9) b.hi = b.lo + 1.0;
+  const double pad = 0.05 * (b.hi - b.lo);
+  f.ystep = nice_step(b.hi - b.lo + 2 * pad, 5.0);
+  f.ylo = static_cast<double>(step_index_down(b.lo - pad, f.ystep)) * f.ystep;
+  f.yhi = static_cast<double>(step_index_up(b.hi + pad, f.ystep)) * f.ystep;
+  return f;
+}
+
+// The script's segments behind panel k: alternate shading, dashed
+// boundaries, and on the first panel their names on top.
+void history_segments(Svg& svg, const Frame& f, std::size_t k,
+                      const std::vector<ScriptSegment>& segs) {
+  const double t0 = f.xlo, t1 = f.xhi;
+  for (std::size_t s = 0; s < segs.size(); ++s) {
+    const double a = std::max(segs[s].t0_s, t0), e = std::min(segs[s].t1_s, t1);
+    if (!(e > a)) continue;
+    if (s % 2 == 1) {
+      svg.rect(f.X(a), f.top, f.X(e) - f.X(a), f.height, attr("fill", "#f3f3f3"));
+    }
+    if (segs[s].t0_s > t0 && segs[s].t0_s < t1) {
+      svg.line(f.X(segs[s].t0_s), f.top, f.X(segs[s].t0_s), f.top + f.height,
+               attr("stroke", "#888") + attr("stroke-width", "0.7") +
+                   attr("stroke-dasharray", "3 3"));
+    }
+    if (k == 0) {
+      svg.text(0.5 * (f.X(a) + f.X(e)), f.top - (s % 2 == 0 ? 16.0 : 5.0),
+               segs[s].name,
+               attr("class", "segment") + attr("text-anchor", "middle") +
+                   attr("font-size", "9") + attr("fill", "#555"));
+    }
+  }
+}
+
+// The panel's series as lines at the decimated rows, clipped to its frame.
+void history_lines(Svg& svg, const Frame& f, const HistoryPanel& hp,
+                   const std::vector<TickRecord>& rows,
+                   const std::vector<std::size_t>& idx,
+                   const std::string& tag) {
+  svg.clip_rect("clip-history-" + tag, f.left, f.top, f.width, f.height);
+  svg.open("g", attr("clip-path", "url(#clip-history-" + tag + ")"));
+  for (const Series& s : hp.series) {
+    std::vector<Pt> pts;
+    pts.reserve(idx.size());
+    for (std::size_t i : idx) pts.push_back(f.at(rows[i].t_s, s.value(rows[i])));
+    svg.polyline(pts, attr("stroke", s.color) + attr("stroke-width", "1") +
+                          (s.dash.empty() ? "" : attr("stroke-dasharray", s.dash)));
+  }
+  svg.close("g");
+}
+
+// The panel's legend right of it: its heading, then a sample of each
+// series' line with its name.
+void history_legend(Svg& svg, const Frame& f, const HistoryPanel& hp) {
+  const double x = HistoryLayout::kLegendX;
+  svg.text(x, f.top + 12.0, hp.heading, attr("font-weight", "bold"));
+  double yy = f.top + 30.0;
+  for (const Series& s : hp.series) {
+    svg.line(x, yy - 4.0, x + 24.0, yy - 4.0,
+             attr("stroke", s.color) + attr("stroke-width", "1.5") +
+                 (s.dash.empty() ? "" : attr("stroke-dasharray", s.dash)));
+    svg.text(x + 30.0, yy, s.name, "");
+    yy += 16.0;
+  }
+}
+
 }  // namespace
 
 std::string views_svg(const std::vector<TickRecord>& rows,
@@ -365,116 +551,27 @@ std::string history_svg(const std::vector<TickRecord>& rows,
   const std::string name = case_name(the_case);
   if (rows.empty()) return empty_document(name);
 
-  const char* const kColor[3] = {"#d62728", "#2ca02c", "#1f77b4"};
-  const char* const kAxis[3] = {"x", "y", "z"};
-  std::vector<HistoryPanel> panels(3);
-  panels[0].ylabel = "(a) p - X(theta_V) (mm)";
-  panels[0].heading = "(a) p - X(theta_V) (mm)";
-  panels[1].ylabel = "(b) p - X(theta_R) (mm)";
-  panels[1].heading = "(b) p - X(theta_R) (mm)";
-  panels[2].ylabel = "(c) force F (N)";
-  panels[2].heading = "(c) commanded force (N)";
-  for (int i = 0; i < 3; ++i) {
-    const std::string c = kAxis[i];
-    panels[0].series.push_back({c, kColor[i], "", [i](const TickRecord& r) {
-                                  return r.out.p_rm_mm[i] - r.out.x_v_mm[i];
-                                }});
-    panels[1].series.push_back({c, kColor[i], "", [i](const TickRecord& r) {
-                                  return r.out.p_rm_mm[i] - r.out.x_r_mm[i];
-                                }});
-    panels[2].series.push_back({"F_" + c, kColor[i], "", [i](const TickRecord& r) {
-                                  return r.out.force_device_N[i];
-                                }});
-  }
-  panels[0].series.push_back({"d_path (distance to the path)", "#000", "5 3",
-                              [](const TickRecord& r) { return r.d_path_mm; }});
-  panels[2].series.push_back({"|F|", "#000", "5 3", [](const TickRecord& r) {
-                                return r.out.force_device_N.norm();
-                              }});
-
-  const double left = 76.0, plot_w = 800.0, plot_h = 180.0, gap = 22.0;
-  const double top0 = 58.0;
-  const double legend_x = left + plot_w + 22.0;
-  const double width = legend_x + 230.0;
-  const double height = top0 + 3.0 * plot_h + 2.0 * gap + 52.0;
-  Svg svg(width, height);
+  const std::vector<HistoryPanel> panels = history_panels();
+  const double legend_x = HistoryLayout::kLegendX;
+  const double height = HistoryLayout::kHeight;
+  Svg svg(HistoryLayout::kWidth, height);
   svg.text(12.0, 20.0,
            name + ": time history of error and force (cf. thesis Figs 4.3, "
                   "4.6, 4.19); device frame",
            attr("font-size", "14") + attr("font-weight", "bold"));
 
-  double t0 = rows.front().t_s, t1 = rows.back().t_s;
-  if (!(t1 > t0)) t1 = t0 + 1e-3;
-  const double tstep = nice_step(t1 - t0, 10.0);
-  // end on a tick when the run nearly does (the last tick is at T - period)
-  const double t_end = static_cast<double>(step_index_up(t1, tstep)) * tstep;
-  if (t_end - t1 < 0.02 * (t1 - t0)) t1 = t_end;
+  const Frame time = history_time_axis(rows);
   const std::vector<std::size_t> idx = decimated(rows.size());
   const std::vector<ScriptSegment>& segs = the_case.script().segments();
-
   for (std::size_t k = 0; k < panels.size(); ++k) {
     const HistoryPanel& hp = panels[k];
-    Frame f;
-    f.left = left;
-    f.top = top0 + static_cast<double>(k) * (plot_h + gap);
-    f.width = plot_w;
-    f.height = plot_h;
-    f.xlo = t0;
-    f.xhi = t1;
-    f.xstep = tstep;
-    Bounds b;
-    b.add(0.0);
-    for (const Series& s : hp.series) {
-      for (std::size_t i : idx) b.add(s.value(rows[i]));
-    }
-    if (b.hi - b.lo < 1e-9) b.hi = b.lo + 1.0;
-    const double pad = 0.05 * (b.hi - b.lo);
-    f.ystep = nice_step(b.hi - b.lo + 2 * pad, 5.0);
-    f.ylo = static_cast<double>(step_index_down(b.lo - pad, f.ystep)) * f.ystep;
-    f.yhi = static_cast<double>(step_index_up(b.hi + pad, f.ystep)) * f.ystep;
-
+    const Frame f = history_frame(time, k, hp, rows, idx);
     const std::string tag = std::string(1, static_cast<char>('a' + k));
     svg.open("g", attr("class", "history") + attr("id", "history-" + tag));
-    // the script's segments: alternate shading, boundaries, names on top
-    for (std::size_t s = 0; s < segs.size(); ++s) {
-      const double a = std::max(segs[s].t0_s, t0), e = std::min(segs[s].t1_s, t1);
-      if (!(e > a)) continue;
-      if (s % 2 == 1) {
-        svg.rect(f.X(a), f.top, f.X(e) - f.X(a), f.height, attr("fill", "#f3f3f3"));
-      }
-      if (segs[s].t0_s > t0 && segs[s].t0_s < t1) {
-        svg.line(f.X(segs[s].t0_s), f.top, f.X(segs[s].t0_s), f.top + f.height,
-                 attr("stroke", "#888") + attr("stroke-width", "0.7") +
-                     attr("stroke-dasharray", "3 3"));
-      }
-      if (k == 0) {
-        svg.text(0.5 * (f.X(a) + f.X(e)), f.top - (s % 2 == 0 ? 16.0 : 5.0),
-                 segs[s].name,
-                 attr("class", "segment") + attr("text-anchor", "middle") +
-                     attr("font-size", "9") + attr("fill", "#555"));
-      }
-    }
+    history_segments(svg, f, k, segs);
     draw_axes(svg, f, "t (s)", hp.ylabel, k + 1 == panels.size());
-    svg.clip_rect("clip-history-" + tag, f.left, f.top, f.width, f.height);
-    svg.open("g", attr("clip-path", "url(#clip-history-" + tag + ")"));
-    for (const Series& s : hp.series) {
-      std::vector<Pt> pts;
-      pts.reserve(idx.size());
-      for (std::size_t i : idx) pts.push_back(f.at(rows[i].t_s, s.value(rows[i])));
-      svg.polyline(pts, attr("stroke", s.color) + attr("stroke-width", "1") +
-                            (s.dash.empty() ? "" : attr("stroke-dasharray", s.dash)));
-    }
-    svg.close("g");
-    // legend
-    svg.text(legend_x, f.top + 12.0, hp.heading, attr("font-weight", "bold"));
-    double yy = f.top + 30.0;
-    for (const Series& s : hp.series) {
-      svg.line(legend_x, yy - 4.0, legend_x + 24.0, yy - 4.0,
-               attr("stroke", s.color) + attr("stroke-width", "1.5") +
-                   (s.dash.empty() ? "" : attr("stroke-dasharray", s.dash)));
-      svg.text(legend_x + 30.0, yy, s.name, "");
-      yy += 16.0;
-    }
+    history_lines(svg, f, hp, rows, idx, tag);
+    history_legend(svg, f, hp);
     svg.close("g");
   }
   const std::size_t every = idx.size() > 1 ? idx[1] - idx[0] : 1;
