@@ -39,13 +39,22 @@ std::string field_num(double v) {
   return s == "-0" ? "0" : s;
 }
 
-// one panel: the path (the circle, the line, or the sphere's outline in
-// this projection), the trajectory and the arrows
-std::string panel(const std::vector<ForceSample>& s,
-                  const std::vector<std::size_t>& picked,
-                  const ForceFieldPath& path, const View& v, double left,
-                  double top, double mm_per_N) {
-  // an equal-aspect square around the path and the trajectory
+// A panel's equal-aspect square: span mm across centred on (c0, c1) of the
+// view's axes, kPanel_px wide with its top left corner at (left, top).
+struct PanelFrame {
+  double left = 0.0, top = 0.0;
+  double c0 = 0.0, c1 = 0.0;  // mm
+  double span = 1.0;          // mm
+  double scale = 1.0;         // px per mm
+  double X(double a) const { return left + kPanel_px / 2 + (a - c0) * scale; }
+  double Y(double b) const { return top + kPanel_px / 2 - (b - c1) * scale; }
+};
+
+// The square around the path (L to either side of the pivot) and the
+// finite points of the trajectory, 15% wider than they are, 1 mm at least.
+PanelFrame panel_frame(const std::vector<ForceSample>& s,
+                       const ForceFieldPath& path, const View& v, double left,
+                       double top) {
   double lo[2] = {path.pivot_mm[v.across] - path.length_mm,
                   path.pivot_mm[v.up] - path.length_mm};
   double hi[2] = {path.pivot_mm[v.across] + path.length_mm,
@@ -56,73 +65,85 @@ std::string panel(const std::vector<ForceSample>& s,
     lo[0] = std::min(lo[0], a), hi[0] = std::max(hi[0], a);
     lo[1] = std::min(lo[1], b), hi[1] = std::max(hi[1], b);
   }
-  const double span = 1.15 * std::max({hi[0] - lo[0], hi[1] - lo[1], 1.0});
-  const double c0 = 0.5 * (lo[0] + hi[0]), c1 = 0.5 * (lo[1] + hi[1]);
-  const double scale = kPanel_px / span;  // px per mm
-  auto X = [&](double a) { return left + kPanel_px / 2 + (a - c0) * scale; };
-  auto Y = [&](double b) { return top + kPanel_px / 2 - (b - c1) * scale; };
+  PanelFrame f;
+  f.left = left;
+  f.top = top;
+  f.span = 1.15 * std::max({hi[0] - lo[0], hi[1] - lo[1], 1.0});
+  f.c0 = 0.5 * (lo[0] + hi[0]);
+  f.c1 = 0.5 * (lo[1] + hi[1]);
+  f.scale = kPanel_px / f.span;
+  return f;
+}
 
-  std::string g = "<g class=\"panel\"" + attr("id", "ff-" + v.tag) +
-                  attr("data-axes", std::string(axis_name(v.across)) + "," +
-                                        axis_name(v.up)) + ">\n";
-  g += "<rect" + attr("x", px(left)) + attr("y", px(top)) +
-       attr("width", px(kPanel_px)) + attr("height", px(kPanel_px)) +
-       " fill=\"none\" stroke=\"#444\"/>\n";
+// The panel's frame, its axes' names (the vertical one left of its tick
+// labels, both outside the frame) and ticks in mm on both axes, at a step
+// giving about five of them.
+std::string panel_axes(const PanelFrame& f, const View& v) {
+  const double left = f.left, top = f.top, span = f.span;
+  std::string g = "<rect" + attr("x", px(left)) + attr("y", px(top)) +
+                  attr("width", px(kPanel_px)) + attr("height", px(kPanel_px)) +
+                  " fill=\"none\" stroke=\"#444\"/>\n";
   g += "<text" + attr("x", px(left + kPanel_px / 2)) +
        attr("y", px(top + kPanel_px + 32)) + " text-anchor=\"middle\">" +
        escape(std::string(axis_name(v.across)) + " (mm, device frame)") +
        "</text>\n";
-  // the axis's name left of its tick labels, both outside the frame
   g += "<text" + attr("x", px(left - 36)) + attr("y", px(top + kPanel_px / 2)) +
        attr("transform", "rotate(-90 " + px(left - 36) + " " +
                              px(top + kPanel_px / 2) + ")") +
        " text-anchor=\"middle\">" +
        escape(std::string(axis_name(v.up)) + " (mm)") + "</text>\n";
-  // ticks in mm on both axes, at a step giving about five of them
   const double step = output::svg::nice_step(span, 5.0);
   for (int axis = 0; axis < 2; ++axis) {
-    const double c = axis == 0 ? c0 : c1;
+    const double c = axis == 0 ? f.c0 : f.c1;
     for (double t = std::ceil((c - span / 2) / step) * step; t <= c + span / 2;
          t += step) {
       const std::string label = field_num(std::abs(t) < 1e-9 * step ? 0.0 : t);
       if (axis == 0) {
-        g += "<line" + attr("x1", px(X(t))) + attr("y1", px(top + kPanel_px)) +
-             attr("x2", px(X(t))) + attr("y2", px(top + kPanel_px + 4)) +
-             " stroke=\"#444\"/>\n<text" + attr("x", px(X(t))) +
+        g += "<line" + attr("x1", px(f.X(t))) + attr("y1", px(top + kPanel_px)) +
+             attr("x2", px(f.X(t))) + attr("y2", px(top + kPanel_px + 4)) +
+             " stroke=\"#444\"/>\n<text" + attr("x", px(f.X(t))) +
              attr("y", px(top + kPanel_px + 15)) +
              " text-anchor=\"middle\">" + label + "</text>\n";
       } else {
-        g += "<line" + attr("x1", px(left - 4)) + attr("y1", px(Y(t))) +
-             attr("x2", px(left)) + attr("y2", px(Y(t))) +
+        g += "<line" + attr("x1", px(left - 4)) + attr("y1", px(f.Y(t))) +
+             attr("x2", px(left)) + attr("y2", px(f.Y(t))) +
              " stroke=\"#444\"/>\n<text" + attr("x", px(left - 6)) +
-             attr("y", px(Y(t) + 4)) + " text-anchor=\"end\">" + label +
+             attr("y", px(f.Y(t) + 4)) + " text-anchor=\"end\">" + label +
              "</text>\n";
       }
     }
   }
-  // the path as the mechanism draws it (thesis/path_svg.h)
-  g += path_elements(vm_path_of(path).primitives,
-                     square_view(Vec3::Unit(v.across), Vec3::Unit(v.up), X, Y,
-                                 scale, c0, c1, span),
-                     "ff-path-" + v.tag,
-                     attr("stroke", "#1f77b4") + attr("stroke-width", "1.5"));
-  // the trajectory, thinned to about 1500 points
+  return g;
+}
+
+// The trajectory as a grey polyline, thinned to about 1500 points, its
+// non-finite points left out ("" when none is left).
+std::string panel_trajectory(const std::vector<ForceSample>& s,
+                             const PanelFrame& f, const View& v) {
   std::string pts;
   const std::size_t k = std::max<std::size_t>(1, s.size() / 1500);
   for (std::size_t i = 0; i < s.size(); i += k) {
     const double a = s[i].p_mm[v.across], b = s[i].p_mm[v.up];
     if (!std::isfinite(a) || !std::isfinite(b)) continue;
-    pts += (pts.empty() ? "" : " ") + px(X(a)) + "," + px(Y(b));
+    pts += (pts.empty() ? "" : " ") + px(f.X(a)) + "," + px(f.Y(b));
   }
-  if (!pts.empty()) {
-    g += "<polyline fill=\"none\" stroke=\"#999\" stroke-width=\"0.8\"" +
+  if (pts.empty()) return "";
+  return "<polyline fill=\"none\" stroke=\"#999\" stroke-width=\"0.8\"" +
          attr("points", pts) + "/>\n";
-  }
+}
+
+// The force at each picked sample as an arrow from the wrist centre,
+// mm_per_N mm per N in the view's plane; shorter than kMinArrow_px or not
+// finite: none.
+std::string panel_arrows(const std::vector<ForceSample>& s,
+                         const std::vector<std::size_t>& picked,
+                         const PanelFrame& f, const View& v, double mm_per_N) {
+  std::string g;
   for (std::size_t i : picked) {
     const ForceSample& r = s[i];
-    const double x1 = X(r.p_mm[v.across]), y1 = Y(r.p_mm[v.up]);
-    const double dx = r.F_N[v.across] * mm_per_N * scale;
-    const double dy = -r.F_N[v.up] * mm_per_N * scale;
+    const double x1 = f.X(r.p_mm[v.across]), y1 = f.Y(r.p_mm[v.up]);
+    const double dx = r.F_N[v.across] * mm_per_N * f.scale;
+    const double dy = -r.F_N[v.up] * mm_per_N * f.scale;
     const double len = std::hypot(dx, dy);
     if (!(len >= kMinArrow_px) || !std::isfinite(x1) || !std::isfinite(y1)) {
       continue;
@@ -140,6 +161,31 @@ std::string panel(const std::vector<ForceSample>& s,
                             px(bx + half * uy) + "," + px(by - half * ux)) +
          "/>\n";
   }
+  return g;
+}
+
+// one panel: the path (the circle, the line, or the sphere's outline in
+// this projection), the trajectory and the arrows
+std::string panel(const std::vector<ForceSample>& s,
+                  const std::vector<std::size_t>& picked,
+                  const ForceFieldPath& path, const View& v, double left,
+                  double top, double mm_per_N) {
+  const PanelFrame f = panel_frame(s, path, v, left, top);
+  std::string g = "<g class=\"panel\"" + attr("id", "ff-" + v.tag) +
+                  attr("data-axes", std::string(axis_name(v.across)) + "," +
+                                        axis_name(v.up)) + ">\n";
+  g += panel_axes(f, v);
+  // the path as the mechanism draws it (thesis/path_svg.h)
+  g += path_elements(
+      vm_path_of(path).primitives,
+      square_view(Vec3::Unit(v.across), Vec3::Unit(v.up),
+                  [&f](double a) { return f.X(a); },
+                  [&f](double b) { return f.Y(b); }, f.scale, f.c0, f.c1,
+                  f.span),
+      "ff-path-" + v.tag,
+      attr("stroke", "#1f77b4") + attr("stroke-width", "1.5"));
+  g += panel_trajectory(s, f, v);
+  g += panel_arrows(s, picked, f, v, mm_per_N);
   return g + "</g>\n";
 }
 
