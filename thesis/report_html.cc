@@ -446,56 +446,65 @@ std::string claim_matrix(const std::vector<ReportCase>& cases) {
   return s + "</table>\n";
 }
 
-std::string report_html(const ReportInputs& in) {
-  const ReportHeader& h = in.header;
-  const ClaimTally tally = tally_claims(in.cases);
+namespace {
+
+// The line under the title: how many claims passed, and those that fail
+// or hold on some sides only.
+std::string claims_summary(const ClaimTally& tally) {
   const bool all_pass = tally.failed.empty();
+  return std::string("<p id=\"summary\" class=\"summary\">Claims passed: ") +
+         "<span class=\"" + (all_pass ? "pass" : "fail") + "\">" +
+         std::to_string(tally.passed) + "/" + std::to_string(tally.total) +
+         "</span>" +
+         (all_pass ? std::string()
+                   : " &#8212; failing: <span class=\"fail\">" +
+                         escape(list_text(tally.failed)) + "</span>") +
+         (tally.partial.empty()
+              ? std::string()
+              : " &#8212; holding on some sides only (the cell names the side "
+                "where it fails): " + escape(list_text(tally.partial))) +
+         "</p>\n";
+}
+
+// The two overviews: which claims hold in which case (claim_matrix), and
+// each case's accuracy and run time, each with its legend.
+std::string overview_sections(const std::vector<ReportCase>& cases) {
   std::string s =
-      "<!DOCTYPE html>\n<html xmlns=\"http://www.w3.org/1999/xhtml\" "
-      "lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n"
-      "<title>vmhaptics report</title>\n<style>" +
-      std::string(kStyle) + "</style>\n</head>\n<body>\n";
-  s += "<h1>vmhaptics: virtual-mechanism control of the PHANTOM Omni, the "
-       "thesis's cases measured</h1>\n";
-  s += std::string("<p id=\"summary\" class=\"summary\">Claims passed: ") +
-       "<span class=\"" + (all_pass ? "pass" : "fail") + "\">" +
-       std::to_string(tally.passed) + "/" + std::to_string(tally.total) +
-       "</span>" +
-       (all_pass ? std::string()
-                 : " &#8212; failing: <span class=\"fail\">" +
-                       escape(list_text(tally.failed)) + "</span>") +
-       (tally.partial.empty()
-            ? std::string()
-            : " &#8212; holding on some sides only (the cell names the side "
-              "where it fails): " + escape(list_text(tally.partial))) +
-       "</p>\n";
-  s += "<section id=\"matrix\">\n<h2>Which claims hold, in which case</h2>\n" +
-       claim_matrix(in.cases) +
-       "<p class=\"legend\">pass: holds on every side it is measured on; "
-       "partial: holds on some, the cell names where it fails; FAIL: fails "
-       "on every side; blank: the case makes no such claim. Each cell links "
-       "to the claim's row with every side's value.</p>\n</section>\n";
+      "<section id=\"matrix\">\n<h2>Which claims hold, in which case</h2>\n" +
+      claim_matrix(cases) +
+      "<p class=\"legend\">pass: holds on every side it is measured on; "
+      "partial: holds on some, the cell names where it fails; FAIL: fails "
+      "on every side; blank: the case makes no such claim. Each cell links "
+      "to the claim's row with every side's value.</p>\n</section>\n";
   s += "<section id=\"runtime\">\n<h2>Accuracy and run time, per case</h2>\n" +
-       run_time_table(in.cases) +
+       run_time_table(cases) +
        "<p class=\"legend\">rms and max path error: the RM wrist centre's "
        "distance from the VM's path after the first second (mm); mean_force_N: "
        "the commanded |F|; realtime_factor: simulated over wall seconds on "
        "this machine.</p>\n</section>\n";
-  s += "<ul class=\"contents\">\n";
-  for (const ReportCase& c : in.cases) {
+  return s;
+}
+
+// The page's contents: each case, the three studies, the page's making.
+std::string contents_list(const std::vector<ReportCase>& cases) {
+  std::string s = "<ul class=\"contents\">\n";
+  for (const ReportCase& c : cases) {
     s += "<li><a href=\"#" + escape(c.name) + "\">" + escape(c.name) + "</a></li>\n";
   }
   s += "<li><a href=\"#precision\">work-precision</a></li>\n"
        "<li><a href=\"#stability\">stability map</a></li>\n"
        "<li><a href=\"#extremes\">extreme scenarios</a></li>\n"
        "<li><a href=\"#about\">how this page was made</a></li>\n</ul>\n";
+  return s;
+}
 
-  for (const ReportCase& c : in.cases) s += case_section(c);
-
-  const ReportStudies& st = in.studies;
-  s += "<section id=\"precision\">\n<h2>Work-precision (" +
-       escape(st.precision_case.empty() ? "not run" : st.precision_case) +
-       ")</h2>\n";
+// The precision study: error against wall time, error against h, and every
+// run's row folded away.
+std::string precision_section(const ReportStudies& st) {
+  const std::string name =
+      st.precision_case.empty() ? "not run" : st.precision_case;
+  std::string s = "<section id=\"precision\">\n<h2>Work-precision (" +
+                  escape(name) + ")</h2>\n";
   s += figure(st.precision_svg, "trajectory error (RMS, mm) against wall "
                                 "time (s), per integrator and physics step",
               "precision", "study/precision.svg");
@@ -506,9 +515,14 @@ std::string report_html(const ReportInputs& in) {
     s += "<details><summary>every run (precision.csv)</summary>\n" +
          csv_table(st.precision_csv, "precision") + "</details>\n";
   }
-  s += "</section>\n";
-  s += "<section id=\"stability\">\n<h2>Stability map of the sampled-data "
-       "wall</h2>\n<p>" + escape(st.stability_note) + "</p>\n";
+  return s + "</section>\n";
+}
+
+// The stability map: its setting, the figure and the table folded away.
+std::string stability_section(const ReportStudies& st) {
+  std::string s = "<section id=\"stability\">\n<h2>Stability map of the "
+                  "sampled-data wall</h2>\n<p>" +
+                  escape(st.stability_note) + "</p>\n";
   s += figure(st.stability_map_svg, "K_crit (N/m) against the virtual "
                                     "damping B (N s/m), per delay",
               "stability-map", "study/stability_map.svg");
@@ -516,8 +530,13 @@ std::string report_html(const ReportInputs& in) {
     s += "<details><summary>the map (stability_map.csv)</summary>\n" +
          csv_table(st.stability_map_csv, "stability") + "</details>\n";
   }
-  s += "</section>\n";
-  s += "<section id=\"extremes\">\n<h2>Extreme scenarios</h2>\n";
+  return s + "</section>\n";
+}
+
+// The extreme scenarios: their table (or "not run") and the observer's
+// energy.
+std::string extremes_section(const ReportStudies& st) {
+  std::string s = "<section id=\"extremes\">\n<h2>Extreme scenarios</h2>\n";
   if (st.extremes.is_null()) {
     s += "<p class=\"note\">not run</p>\n";
   } else {
@@ -525,8 +544,13 @@ std::string report_html(const ReportInputs& in) {
   }
   s += figure(st.extremes_svg, "the passivity observer's energy per scenario (mJ)",
               "extremes", "study/extremes.svg");
-  s += "</section>\n";
-  s += "<section id=\"about\">\n<h2>How this page was made</h2>\n";
+  return s + "</section>\n";
+}
+
+// How the page was made: the software, where and when, what ran and what
+// was reused.
+std::string about_section(const ReportHeader& h) {
+  std::string s = "<section id=\"about\">\n<h2>How this page was made</h2>\n";
   s += "<table class=\"header\">\n";
   s += "<tr>" + th("software") + td("vmhaptics " + h.version) + "</tr>\n";
   s += "<tr>" + th("git describe (at configure time)") + td(h.git_describe) + "</tr>\n";
@@ -536,7 +560,28 @@ std::string report_html(const ReportInputs& in) {
   s += "<tr>" + th("wall time (s)") + td(num(PageJson(h.wall_s))) + "</tr>\n";
   s += "<tr>" + th("ran") + td(list_text(h.ran)) + "</tr>\n";
   s += "<tr>" + th("reused from disk") + td(list_text(h.reused)) + "</tr>\n";
-  s += "</table>\n</section>\n";
+  return s + "</table>\n</section>\n";
+}
+
+}  // namespace
+
+std::string report_html(const ReportInputs& in) {
+  const ClaimTally tally = tally_claims(in.cases);
+  std::string s =
+      "<!DOCTYPE html>\n<html xmlns=\"http://www.w3.org/1999/xhtml\" "
+      "lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n"
+      "<title>vmhaptics report</title>\n<style>" +
+      std::string(kStyle) + "</style>\n</head>\n<body>\n";
+  s += "<h1>vmhaptics: virtual-mechanism control of the PHANTOM Omni, the "
+       "thesis's cases measured</h1>\n";
+  s += claims_summary(tally);
+  s += overview_sections(in.cases);
+  s += contents_list(in.cases);
+  for (const ReportCase& c : in.cases) s += case_section(c);
+  s += precision_section(in.studies);
+  s += stability_section(in.studies);
+  s += extremes_section(in.studies);
+  s += about_section(in.header);
   s += "<p class=\"summary\">Claims passed: " + std::to_string(tally.passed) +
        "/" + std::to_string(tally.total) + "</p>\n</body>\n</html>\n";
   return s;
