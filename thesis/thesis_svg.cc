@@ -57,12 +57,28 @@ struct Column {
   int n = 0;
 };
 
-// one time plot of theta_V[k] and theta_R[k]: min/max bands per pixel
-// column and their means, or every row's line when there are fewer rows
-// than columns
-std::string time_plot(const std::vector<ThesisSample>& s, std::size_t k,
-                      double top, double width, int columns, bool last) {
-  const double t0 = s.front().t_s, t1 = std::max(s.back().t_s, t0 + 1e-9);
+// A time plot's frame: t0..t1 (s) across `width` px from kLeft_px, lo..hi
+// (rad) up kPlotH_px from top + kPlotH_px, ticks ystep apart.
+struct TimeFrame {
+  double t0 = 0.0, t1 = 1.0;
+  double lo = 0.0, hi = 1.0, ystep = 1.0;
+  double top = 0.0, width = 1.0;
+  double X(double t) const { return kLeft_px + (t - t0) / (t1 - t0) * width; }
+  double Y(double v) const {
+    return top + kPlotH_px - (v - lo) / (hi - lo) * kPlotH_px;
+  }
+};
+
+// The frame of theta_V[k] and theta_R[k]: the run's span (1 ns at least)
+// and their finite values' range (1 rad around a constant), out to whole
+// ticks of about a quarter of it.
+TimeFrame time_frame(const std::vector<ThesisSample>& s, std::size_t k,
+                     double top, double width) {
+  TimeFrame f;
+  f.top = top;
+  f.width = width;
+  f.t0 = s.front().t_s;
+  f.t1 = std::max(s.back().t_s, f.t0 + 1e-9);
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const ThesisSample& r : s) {
     for (const auto* v : {&r.theta_v, &r.theta_r}) {
@@ -73,73 +89,101 @@ std::string time_plot(const std::vector<ThesisSample>& s, std::size_t k,
     }
   }
   if (!(hi > lo)) { lo -= 0.5; hi += 0.5; }
-  const double ystep = nice_step(hi - lo, 4.0);
-  lo = std::floor(lo / ystep) * ystep;
-  hi = std::ceil(hi / ystep) * ystep;
-  auto X = [&](double t) { return kLeft_px + (t - t0) / (t1 - t0) * width; };
-  auto Y = [&](double v) { return top + kPlotH_px - (v - lo) / (hi - lo) * kPlotH_px; };
-  std::string g = "<g class=\"theta\">\n";
-  g += "<rect" + attr("x", px(kLeft_px)) + attr("y", px(top)) + attr("width", px(width)) +
-       attr("height", px(kPlotH_px)) + " fill=\"none\" stroke=\"#444\"/>\n";
-  for (double v = lo; v <= hi + 1e-9 * ystep; v += ystep) {
-    g += "<line" + attr("x1", px(kLeft_px - 4)) + attr("y1", px(Y(v))) +
-         attr("x2", px(kLeft_px)) + attr("y2", px(Y(v))) + " stroke=\"#444\"/>\n";
-    g += "<text" + attr("x", px(kLeft_px - 6)) + attr("y", px(Y(v) + 4)) +
+  f.ystep = nice_step(hi - lo, 4.0);
+  f.lo = std::floor(lo / f.ystep) * f.ystep;
+  f.hi = std::ceil(hi / f.ystep) * f.ystep;
+  return f;
+}
+
+// The plot's frame and ticks: theta (rad) on the left, t (s) below, and
+// the t axis's name under the last plot only. `name` is "" or "_<k+1>".
+std::string time_axes(const TimeFrame& f, bool last, const std::string& name) {
+  const double top = f.top, width = f.width, ystep = f.ystep;
+  std::string g = "<rect" + attr("x", px(kLeft_px)) + attr("y", px(top)) +
+                  attr("width", px(width)) + attr("height", px(kPlotH_px)) +
+                  " fill=\"none\" stroke=\"#444\"/>\n";
+  for (double v = f.lo; v <= f.hi + 1e-9 * ystep; v += ystep) {
+    g += "<line" + attr("x1", px(kLeft_px - 4)) + attr("y1", px(f.Y(v))) +
+         attr("x2", px(kLeft_px)) + attr("y2", px(f.Y(v))) + " stroke=\"#444\"/>\n";
+    g += "<text" + attr("x", px(kLeft_px - 6)) + attr("y", px(f.Y(v) + 4)) +
          " text-anchor=\"end\">" + thesis_num(std::abs(v) < 1e-9 * ystep ? 0.0 : v) + "</text>\n";
   }
-  const double tstep = nice_step(t1 - t0, 8.0);
-  for (double t = std::ceil(t0 / tstep) * tstep; t <= t1 + 1e-9; t += tstep) {
-    g += "<line" + attr("x1", px(X(t))) + attr("y1", px(top + kPlotH_px)) +
-         attr("x2", px(X(t))) + attr("y2", px(top + kPlotH_px + 4)) + " stroke=\"#444\"/>\n";
-    g += "<text" + attr("x", px(X(t))) + attr("y", px(top + kPlotH_px + 16)) +
+  const double tstep = nice_step(f.t1 - f.t0, 8.0);
+  for (double t = std::ceil(f.t0 / tstep) * tstep; t <= f.t1 + 1e-9; t += tstep) {
+    g += "<line" + attr("x1", px(f.X(t))) + attr("y1", px(top + kPlotH_px)) +
+         attr("x2", px(f.X(t))) + attr("y2", px(top + kPlotH_px + 4)) + " stroke=\"#444\"/>\n";
+    g += "<text" + attr("x", px(f.X(t))) + attr("y", px(top + kPlotH_px + 16)) +
          " text-anchor=\"middle\">" + thesis_num(t) + "</text>\n";
   }
   if (last) {
     g += "<text" + attr("x", px(kLeft_px + width / 2)) + attr("y", px(top + kPlotH_px + 32)) +
          " text-anchor=\"middle\">t (s)</text>\n";
   }
-  const std::string name = s.front().theta_v.size() > 1 ? "_" + std::to_string(k + 1) : "";
   g += "<text" + attr("x", px(16)) + attr("y", px(top + kPlotH_px / 2)) +
        attr("transform", "rotate(-90 16 " + px(top + kPlotH_px / 2) + ")") +
        " text-anchor=\"middle\">" + escape("theta" + name + " (rad)") + "</text>\n";
+  return g;
+}
+
+// theta_V[k] (which 0) or theta_R[k] (which 1) as a min/max band per pixel
+// column, shaded, and the columns' means as a line.
+std::string theta_bands(const std::vector<ThesisSample>& s, std::size_t k,
+                        int which, const TimeFrame& f, int columns,
+                        const char* colour) {
+  const double t0 = f.t0, t1 = f.t1, width = f.width;
+  std::vector<Column> col(static_cast<std::size_t>(columns));
+  for (const ThesisSample& r : s) {
+    const auto& v = which == 0 ? r.theta_v : r.theta_r;
+    if (k >= v.size() || !std::isfinite(v[k])) continue;
+    const int c = std::min(columns - 1, static_cast<int>((r.t_s - t0) / (t1 - t0) * columns));
+    Column& cc = col[static_cast<std::size_t>(std::max(c, 0))];
+    cc.lo = std::min(cc.lo, v[k]);
+    cc.hi = std::max(cc.hi, v[k]);
+    cc.sum += v[k];
+    ++cc.n;
+  }
+  std::string upper, lower, mean;
+  for (int c = 0; c < columns; ++c) {
+    const Column& cc = col[static_cast<std::size_t>(c)];
+    if (cc.n == 0) continue;
+    const double x = kLeft_px + (c + 0.5) / columns * width;
+    upper += (upper.empty() ? "M" : " L") + px(x) + "," + px(f.Y(cc.hi));
+    lower = " L" + px(x) + "," + px(f.Y(cc.lo)) + lower;
+    mean += (mean.empty() ? "M" : " L") + px(x) + "," + px(f.Y(cc.sum / cc.n));
+  }
+  std::string g = "<path class=\"band\"" + attr("d", upper + lower + " Z") +
+                  attr("fill", colour) + " fill-opacity=\"0.25\" stroke=\"none\"/>\n";
+  g += "<path" + attr("d", mean) + attr("stroke", colour) +
+       " fill=\"none\" stroke-width=\"1.2\"/>\n";
+  return g;
+}
+
+// theta_V[k] (which 0) or theta_R[k] (which 1) as a line through every row.
+std::string theta_line(const std::vector<ThesisSample>& s, std::size_t k,
+                       int which, const TimeFrame& f, const char* colour) {
+  std::string d;
+  for (const ThesisSample& r : s) {
+    const auto& v = which == 0 ? r.theta_v : r.theta_r;
+    if (k >= v.size() || !std::isfinite(v[k])) continue;
+    d += (d.empty() ? "M" : " L") + px(f.X(r.t_s)) + "," + px(f.Y(v[k]));
+  }
+  return "<path" + attr("d", d) + attr("stroke", colour) +
+         " fill=\"none\" stroke-width=\"1.2\"/>\n";
+}
+
+// one time plot of theta_V[k] and theta_R[k]: min/max bands per pixel
+// column and their means, or every row's line when there are fewer rows
+// than columns
+std::string time_plot(const std::vector<ThesisSample>& s, std::size_t k,
+                      double top, double width, int columns, bool last) {
+  const TimeFrame f = time_frame(s, k, top, width);
+  const std::string name = s.front().theta_v.size() > 1 ? "_" + std::to_string(k + 1) : "";
+  std::string g = "<g class=\"theta\">\n" + time_axes(f, last, name);
   const bool bands = static_cast<int>(s.size()) > columns;
   for (int which = 0; which < 2; ++which) {
     const char* colour = which == 0 ? kV : kR;
-    if (bands) {
-      std::vector<Column> col(static_cast<std::size_t>(columns));
-      for (const ThesisSample& r : s) {
-        const auto& v = which == 0 ? r.theta_v : r.theta_r;
-        if (k >= v.size() || !std::isfinite(v[k])) continue;
-        const int c = std::min(columns - 1, static_cast<int>((r.t_s - t0) / (t1 - t0) * columns));
-        Column& cc = col[static_cast<std::size_t>(std::max(c, 0))];
-        cc.lo = std::min(cc.lo, v[k]);
-        cc.hi = std::max(cc.hi, v[k]);
-        cc.sum += v[k];
-        ++cc.n;
-      }
-      std::string upper, lower, mean;
-      for (int c = 0; c < columns; ++c) {
-        const Column& cc = col[static_cast<std::size_t>(c)];
-        if (cc.n == 0) continue;
-        const double x = kLeft_px + (c + 0.5) / columns * width;
-        upper += (upper.empty() ? "M" : " L") + px(x) + "," + px(Y(cc.hi));
-        lower = " L" + px(x) + "," + px(Y(cc.lo)) + lower;
-        mean += (mean.empty() ? "M" : " L") + px(x) + "," + px(Y(cc.sum / cc.n));
-      }
-      g += "<path class=\"band\"" + attr("d", upper + lower + " Z") +
-           attr("fill", colour) + " fill-opacity=\"0.25\" stroke=\"none\"/>\n";
-      g += "<path" + attr("d", mean) + attr("stroke", colour) +
-           " fill=\"none\" stroke-width=\"1.2\"/>\n";
-    } else {
-      std::string d;
-      for (const ThesisSample& r : s) {
-        const auto& v = which == 0 ? r.theta_v : r.theta_r;
-        if (k >= v.size() || !std::isfinite(v[k])) continue;
-        d += (d.empty() ? "M" : " L") + px(X(r.t_s)) + "," + px(Y(v[k]));
-      }
-      g += "<path" + attr("d", d) + attr("stroke", colour) +
-           " fill=\"none\" stroke-width=\"1.2\"/>\n";
-    }
+    g += bands ? theta_bands(s, k, which, f, columns, colour)
+               : theta_line(s, k, which, f, colour);
   }
   return g + "</g>\n";
 }
