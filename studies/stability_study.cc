@@ -75,9 +75,8 @@ int SliderWall::horizon_ticks(double k_N_per_m) const {
       std::clamp(std::ceil(ticks), double{kMinHorizonTicks}, 1e7));
 }
 
-WallRun SliderWall::run(double k_N_per_m, int ticks,
-                        std::vector<double>* x_per_tick) {
-  if (ticks <= 0) ticks = horizon_ticks(k_N_per_m);
+void SliderWall::run_ticks(double k_N_per_m, int ticks,
+                           std::vector<double>* xs, WallRun* r) {
   mjModel* m = m_.get();
   mjData* d = d_.get();
   mj_resetData(m, d);
@@ -92,15 +91,12 @@ WallRun SliderWall::run(double k_N_per_m, int ticks,
   std::size_t oldest = 0;
   double x_prev = x0;
 
-  std::vector<double> xs;
-  xs.reserve(static_cast<std::size_t>(ticks) + 1);
-  WallRun r;
-  r.k_N_per_m = k_N_per_m;
+  xs->reserve(static_cast<std::size_t>(ticks) + 1);
   for (int k = 0; k < ticks; ++k) {
     const double x = d->qpos[0];
-    xs.push_back(x);
+    xs->push_back(x);
     if (!std::isfinite(x) || std::abs(x) > kDivergedFactor * x0) {
-      r.diverged = true;
+      r->diverged = true;
       break;
     }
     // the controller's tick: sample, backward difference, wall force
@@ -118,75 +114,113 @@ WallRun SliderWall::run(double k_N_per_m, int ticks,
     // held over the period while the physics steps
     d->ctrl[0] = f;
     for (int j = 0; j < steps_per_tick_; ++j) mj_step(m, d);
-    ++r.ticks;
+    ++r->ticks;
   }
-  if (!r.diverged) xs.push_back(d->qpos[0]);
+  if (!r->diverged) xs->push_back(d->qpos[0]);
+}
+
+void SliderWall::throw_if_warned(double k_N_per_m) const {
   for (int i = 0; i < mjNWARNING; ++i) {
-    if (d->warning[i].number > 0) {
+    if (d_->warning[i].number > 0) {
       throw std::runtime_error(
           "stability study: MuJoCo warning " + std::to_string(i) +
           " during a run at K = " + output::significant(k_N_per_m, 10) + " N/m");
     }
   }
-  if (x_per_tick != nullptr) *x_per_tick = xs;
+}
 
+namespace {
+
+// A run stopped when |x| passed kDivergedFactor x0: unstable, its growth
+// rate from x0 to the last |x| over the ticks run.
+void judge_diverged(const std::vector<double>& xs, double T, WallRun* r) {
+  const double x0 = kInitialDisplacement_m;
   const std::size_t L = xs.size();
-  if (r.diverged) {
-    r.stable = false;
-    r.early_peak_m = x0;
-    r.late_peak_m = std::abs(xs.back());
-    r.growth_rate_per_s = std::log(r.late_peak_m / x0) /
-                          (static_cast<double>(std::max<std::size_t>(L, 2) - 1) * T);
-    return r;
-  }
+  r->stable = false;
+  r->early_peak_m = x0;
+  r->late_peak_m = std::abs(xs.back());
+  r->growth_rate_per_s = std::log(r->late_peak_m / x0) /
+                         (static_cast<double>(std::max<std::size_t>(L, 2) - 1) * T);
+}
 
-  // The envelope. For one oscillatory mode x_k = A rho^k cos(k theta + phi)
-  // the quantity Q_k = x_k² - x_{k-1} x_{k+1} equals A² sin²(theta) rho^{2k}
-  // exactly: a smooth exponential without the oscillation, so the sum of Q
-  // over a late window against an early one gives rho even when it is
-  // within 1e-6 of 1, where peaks of |x| sampled once a tick would be
-  // swamped by where the samples fall. (The sampled sequence of this linear
-  // loop is exactly that of a linear discrete system, whatever h is.)
-  // The loop's other modes, the backward difference's and the delay
-  // line's, are real or fast and die out within tens of ticks near K_crit;
-  // the early window starts a third of the way into the run (at least 100
-  // ticks), after them. Each window is one period of sqrt(K/m) long, at most
-  // a quarter of the run. If a window's sum is not positive (a mode at
-  // z = -1, where sin(theta) = 0), the sums of x² are used instead.
+// The sums over the window [a, b) of Q_k = x_k² - x_{k-1} x_{k+1}, of x_k²
+// and the largest |x_k| (judge_envelope says why Q).
+double window_sum_q(const std::vector<double>& xs, std::size_t a,
+                    std::size_t b) {
+  double s = 0.0;
+  for (std::size_t k = a; k < b; ++k) {
+    s += xs[k] * xs[k] - xs[k - 1] * xs[k + 1];
+  }
+  return s;
+}
+double window_sum_x2(const std::vector<double>& xs, std::size_t a,
+                     std::size_t b) {
+  double s = 0.0;
+  for (std::size_t k = a; k < b; ++k) s += xs[k] * xs[k];
+  return s;
+}
+double window_peak(const std::vector<double>& xs, std::size_t a,
+                   std::size_t b) {
+  double s = 0.0;
+  for (std::size_t k = a; k < b; ++k) s = std::max(s, std::abs(xs[k]));
+  return s;
+}
+
+// The envelope of a run that did not diverge, x_k over its ticks at
+// stiffness k_N_per_m on mass_kg, period T: its growth rate, whether it
+// decays, and the early and late windows' peaks.
+//
+// For one oscillatory mode x_k = A rho^k cos(k theta + phi)
+// the quantity Q_k = x_k² - x_{k-1} x_{k+1} equals A² sin²(theta) rho^{2k}
+// exactly: a smooth exponential without the oscillation, so the sum of Q
+// over a late window against an early one gives rho even when it is
+// within 1e-6 of 1, where peaks of |x| sampled once a tick would be
+// swamped by where the samples fall. (The sampled sequence of this linear
+// loop is exactly that of a linear discrete system, whatever h is.)
+// The loop's other modes, the backward difference's and the delay
+// line's, are real or fast and die out within tens of ticks near K_crit;
+// the early window starts a third of the way into the run (at least 100
+// ticks), after them. Each window is one period of sqrt(K/m) long, at most
+// a quarter of the run. If a window's sum is not positive (a mode at
+// z = -1, where sin(theta) = 0), the sums of x² are used instead.
+void judge_envelope(const std::vector<double>& xs, double k_N_per_m,
+                    double mass_kg, double T, WallRun* r) {
+  const std::size_t L = xs.size();
   const double period_ticks =
-      2.0 * kPi * std::sqrt(p_.mass_kg / std::max(k_N_per_m, 1e-300)) / T;
+      2.0 * kPi * std::sqrt(mass_kg / std::max(k_N_per_m, 1e-300)) / T;
   const std::size_t W = static_cast<std::size_t>(std::clamp(
       std::round(period_ticks), 10.0, std::floor(static_cast<double>(L) / 4.0)));
   const std::size_t e0 = L / 3, e1 = e0 + W;  // early window [e0, e1)
   const std::size_t l0 = L - 1 - W, l1 = L - 1;  // late window [l0, l1)
-  auto sum_q = [&](std::size_t a, std::size_t b) {
-    double s = 0.0;
-    for (std::size_t k = a; k < b; ++k) {
-      s += xs[k] * xs[k] - xs[k - 1] * xs[k + 1];
-    }
-    return s;
-  };
-  auto sum_x2 = [&](std::size_t a, std::size_t b) {
-    double s = 0.0;
-    for (std::size_t k = a; k < b; ++k) s += xs[k] * xs[k];
-    return s;
-  };
-  auto peak = [&](std::size_t a, std::size_t b) {
-    double s = 0.0;
-    for (std::size_t k = a; k < b; ++k) s = std::max(s, std::abs(xs[k]));
-    return s;
-  };
-  double early = sum_q(e0, e1), late = sum_q(l0, l1);
+  double early = window_sum_q(xs, e0, e1), late = window_sum_q(xs, l0, l1);
   if (!(early > 0.0 && late > 0.0)) {
-    early = sum_x2(e0, e1);
-    late = sum_x2(l0, l1);
+    early = window_sum_x2(xs, e0, e1);
+    late = window_sum_x2(xs, l0, l1);
   }
   const double dk = static_cast<double>(l0) - static_cast<double>(e0);
   // both sums go as rho^{2k}
-  r.growth_rate_per_s = std::log(late / early) / (2.0 * dk * T);
-  r.stable = late < early;
-  r.early_peak_m = peak(e0, e1);
-  r.late_peak_m = peak(l0, l1);
+  r->growth_rate_per_s = std::log(late / early) / (2.0 * dk * T);
+  r->stable = late < early;
+  r->early_peak_m = window_peak(xs, e0, e1);
+  r->late_peak_m = window_peak(xs, l0, l1);
+}
+
+}  // namespace
+
+WallRun SliderWall::run(double k_N_per_m, int ticks,
+                        std::vector<double>* x_per_tick) {
+  if (ticks <= 0) ticks = horizon_ticks(k_N_per_m);
+  std::vector<double> xs;
+  WallRun r;
+  r.k_N_per_m = k_N_per_m;
+  run_ticks(k_N_per_m, ticks, &xs, &r);
+  throw_if_warned(k_N_per_m);
+  if (x_per_tick != nullptr) *x_per_tick = xs;
+  if (r.diverged) {
+    judge_diverged(xs, p_.servo_period_s, &r);
+  } else {
+    judge_envelope(xs, k_N_per_m, p_.mass_kg, p_.servo_period_s, &r);
+  }
   return r;
 }
 

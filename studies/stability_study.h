@@ -93,6 +93,15 @@ class SliderWall {
               std::vector<double>* x_per_tick = nullptr);
 
  private:
+  // From x = kInitialDisplacement_m at rest, `ticks` servo ticks of the
+  // wall at stiffness K (or until |x| passes kDivergedFactor x0, when
+  // r->diverged is set): x_k appended to *xs each tick, and the last x after
+  // the last tick unless diverged; r->ticks counts them.
+  void run_ticks(double k_N_per_m, int ticks, std::vector<double>* xs,
+                 WallRun* r);
+  // std::runtime_error naming the warning and K if MuJoCo warned in the run
+  void throw_if_warned(double k_N_per_m) const;
+
   StabilityParams p_;
   sim::ModelPtr m_;
   sim::DataPtr d_;
