@@ -196,11 +196,10 @@ std::string stability_map_csv(const std::vector<MapPoint>& points) {
   return out;
 }
 
-std::string stability_map_svg(const std::vector<MapPoint>& points,
-                              const StabilityParams& base) {
-  // one colour per delay; the three series of a delay share it
-  static const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c",
-                                        "#9467bd", "#ff7f0e", "#8c564b"};
+namespace {
+
+// the delays of the map, in the order its points first give them
+std::vector<int> map_delays(const std::vector<MapPoint>& points) {
   std::vector<int> delays;
   for (const MapPoint& p : points) {
     if (std::find(delays.begin(), delays.end(), p.delay_ticks) ==
@@ -208,6 +207,106 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
       delays.push_back(p.delay_ticks);
     }
   }
+  return delays;
+}
+
+// For delay n, in `color`: the simulated K_crit as markers, the exact
+// discrete boundary as a line and Gil et al.'s bound dashed, against B.
+void add_delay_series(const std::vector<MapPoint>& points, int n,
+                      const std::string& color, output::Chart* c) {
+  const std::string tag = "n = " + std::to_string(n);
+  output::ChartSeries sim, exact, gil;
+  sim.label = "simulated, " + tag;
+  sim.line = false;
+  exact.label = "exact discrete, " + tag;
+  exact.markers = false;
+  gil.label = "Gil et al. (b+B)/(T/2+nT), " + tag;
+  gil.markers = false;
+  gil.dashed = true;
+  sim.color = exact.color = gil.color = color;
+  for (const MapPoint& p : points) {
+    if (p.delay_ticks != n) continue;
+    const double B = p.virtual_damping_Ns_per_m;
+    sim.x.push_back(B);
+    sim.y.push_back(p.sim.k_crit_N_per_m);
+    exact.x.push_back(B);
+    exact.y.push_back(p.k_crit_exact_N_per_m);
+    gil.x.push_back(B);
+    gil.y.push_back(p.k_bound_gil_N_per_m);
+  }
+  c->series.push_back(sim);
+  c->series.push_back(exact);
+  c->series.push_back(gil);
+}
+
+// Colgate and Schenkel's passivity bound 2(b-B)/T where it is >= 0, from
+// the points of delay n (it does not depend on the delay), closed at B = b
+// where it reaches 0 if the map goes that far. *B_max: the map's largest B.
+output::ChartSeries passivity_series(const std::vector<MapPoint>& points,
+                                     int n, double b, double* B_max) {
+  output::ChartSeries passive;
+  passive.label = "passivity 2(b-B)/T (Colgate & Schenkel)";
+  passive.markers = false;
+  passive.dashed = true;
+  passive.color = "#888888";
+  *B_max = 0.0;
+  for (const MapPoint& p : points) {
+    *B_max = std::max(*B_max, p.virtual_damping_Ns_per_m);
+    if (p.delay_ticks != n || p.k_passivity_N_per_m < 0.0) {
+      continue;
+    }
+    passive.x.push_back(p.virtual_damping_Ns_per_m);
+    passive.y.push_back(p.k_passivity_N_per_m);
+  }
+  if (b <= *B_max && (passive.x.empty() || passive.x.back() < b)) {
+    passive.x.push_back(b);
+    passive.y.push_back(0.0);
+  }
+  return passive;
+}
+
+// The passivity line, drawn when it reaches a visible length: with b small
+// against the map's B range (the Omni's 0.028 of 8 N s/m, or 2 of 100 for
+// 1 kg) the whole line (B from 0 to b) is 2% of both axes or less, a few
+// pixels hidden under the first markers, so a legend entry would name a
+// line no one can see. Then the subtitle gives its end points instead.
+void add_passivity(const output::ChartSeries& passive, double B_max,
+                   const StabilityParams& base, output::Chart* c) {
+  const double b = base.damping_Ns_per_m;
+  double K_max = 0.0;
+  for (const output::ChartSeries& s : c->series) {
+    for (double k : s.y) K_max = std::max(K_max, k);
+  }
+  double x_span = 0.0, y_span = 0.0;
+  if (!passive.x.empty()) {
+    const auto [x_lo, x_hi] =
+        std::minmax_element(passive.x.begin(), passive.x.end());
+    const auto [y_lo, y_hi] =
+        std::minmax_element(passive.y.begin(), passive.y.end());
+    x_span = *x_hi - *x_lo;
+    y_span = *y_hi - *y_lo;
+  }
+  constexpr double kVisible = 0.05;  // of an axis' data range, ~20 px
+  if (x_span >= kVisible * B_max || y_span >= kVisible * K_max) {
+    c->series.push_back(passive);
+  } else if (!passive.x.empty()) {
+    char note[200];
+    std::snprintf(note, sizeof note,
+                  "passivity bound 2(b-B)/T: %.4g N/m at B = 0, 0 at B = b = "
+                  "%.3g N s/m (too short to draw)",
+                  2.0 * b / base.servo_period_s, b);
+    c->subtitle = note;
+  }
+}
+
+}  // namespace
+
+std::string stability_map_svg(const std::vector<MapPoint>& points,
+                              const StabilityParams& base) {
+  // one colour per delay; the three series of a delay share it
+  static const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c",
+                                        "#9467bd", "#ff7f0e", "#8c564b"};
+  const std::vector<int> delays = map_delays(points);
   output::Chart c;
   char title[256];
   std::snprintf(title, sizeof title,
@@ -222,81 +321,15 @@ std::string stability_map_svg(const std::vector<MapPoint>& points,
   c.width_px = 860;
   c.height_px = 500;
   for (std::size_t i = 0; i < delays.size(); ++i) {
-    const int n = delays[i];
-    const std::string color = kColors[i % (sizeof kColors / sizeof *kColors)];
-    const std::string tag = "n = " + std::to_string(n);
-    output::ChartSeries sim, exact, gil;
-    sim.label = "simulated, " + tag;
-    sim.line = false;
-    exact.label = "exact discrete, " + tag;
-    exact.markers = false;
-    gil.label = "Gil et al. (b+B)/(T/2+nT), " + tag;
-    gil.markers = false;
-    gil.dashed = true;
-    sim.color = exact.color = gil.color = color;
-    for (const MapPoint& p : points) {
-      if (p.delay_ticks != n) continue;
-      const double B = p.virtual_damping_Ns_per_m;
-      sim.x.push_back(B);
-      sim.y.push_back(p.sim.k_crit_N_per_m);
-      exact.x.push_back(B);
-      exact.y.push_back(p.k_crit_exact_N_per_m);
-      gil.x.push_back(B);
-      gil.y.push_back(p.k_bound_gil_N_per_m);
-    }
-    c.series.push_back(sim);
-    c.series.push_back(exact);
-    c.series.push_back(gil);
+    add_delay_series(points, delays[i],
+                     kColors[i % (sizeof kColors / sizeof *kColors)], &c);
   }
-  output::ChartSeries passive;
-  passive.label = "passivity 2(b-B)/T (Colgate & Schenkel)";
-  passive.markers = false;
-  passive.dashed = true;
-  passive.color = "#888888";
-  // where it is >= 0: up to B = b, where it reaches 0
+  // the bound from the first delay's points (any n: without points, none)
   double B_max = 0.0;
-  for (const MapPoint& p : points) {
-    B_max = std::max(B_max, p.virtual_damping_Ns_per_m);
-    if (p.delay_ticks != delays.front() || p.k_passivity_N_per_m < 0.0) {
-      continue;
-    }
-    passive.x.push_back(p.virtual_damping_Ns_per_m);
-    passive.y.push_back(p.k_passivity_N_per_m);
-  }
-  const double b = base.damping_Ns_per_m;
-  if (b <= B_max && (passive.x.empty() || passive.x.back() < b)) {
-    passive.x.push_back(b);
-    passive.y.push_back(0.0);
-  }
-  // Drawn when it reaches a visible length: with b small against the map's
-  // B range (the Omni's 0.028 of 8 N s/m, or 2 of 100 for 1 kg) the whole
-  // line (B from 0 to b) is 2% of both axes or less, a few pixels hidden
-  // under the first markers, so a legend entry would name a line no one can
-  // see. Then the subtitle gives its end points instead.
-  double K_max = 0.0;
-  for (const output::ChartSeries& s : c.series) {
-    for (double k : s.y) K_max = std::max(K_max, k);
-  }
-  double x_span = 0.0, y_span = 0.0;
-  if (!passive.x.empty()) {
-    const auto [x_lo, x_hi] =
-        std::minmax_element(passive.x.begin(), passive.x.end());
-    const auto [y_lo, y_hi] =
-        std::minmax_element(passive.y.begin(), passive.y.end());
-    x_span = *x_hi - *x_lo;
-    y_span = *y_hi - *y_lo;
-  }
-  constexpr double kVisible = 0.05;  // of an axis' data range, ~20 px
-  if (x_span >= kVisible * B_max || y_span >= kVisible * K_max) {
-    c.series.push_back(passive);
-  } else if (!passive.x.empty()) {
-    char note[200];
-    std::snprintf(note, sizeof note,
-                  "passivity bound 2(b-B)/T: %.4g N/m at B = 0, 0 at B = b = "
-                  "%.3g N s/m (too short to draw)",
-                  2.0 * b / base.servo_period_s, b);
-    c.subtitle = note;
-  }
+  const output::ChartSeries passive =
+      passivity_series(points, delays.empty() ? 0 : delays.front(),
+                       base.damping_Ns_per_m, &B_max);
+  add_passivity(passive, B_max, base, &c);
   return output::chart_svg(c);
 }
 
