@@ -292,71 +292,76 @@ std::vector<std::size_t> shard_points(std::size_t points, int k, int n) {
   return out;
 }
 
-SweepPlan plan_sweep(const SensitivityOptions& options) {
-  SweepPlan plan;
-  plan.options = options;
-  if (options.cases.empty()) throw SimError("sensitivity: no case to sweep");
-  const int count = options.levels > 0 ? options.levels : (options.quick ? 2 : 5);
-  const int samples =
-      options.samples >= 0 ? options.samples : (options.quick ? 16 : 64);
-  plan.options.levels = count;
-  plan.options.samples = samples;
+namespace {
+
+// The table swept: options.parameters or sweep_parameters(), each row
+// checked; an optional row whose case field this build lacks goes into
+// plan->omitted, a required one is an error.
+void plan_parameters(const SensitivityOptions& options, SweepPlan* plan) {
   const std::vector<SweepParameter>& table =
       options.parameters.empty() ? sweep_parameters() : options.parameters;
   for (const SweepParameter& p : table) {
     check_row(p);
     if (!p.field.empty() && sim::find_param(p.field) == nullptr) {
       if (p.optional) {
-        plan.omitted.push_back(p.name + ": the case table has no field '" +
-                               p.field + "' in this build");
+        plan->omitted.push_back(p.name + ": the case table has no field '" +
+                                p.field + "' in this build");
         continue;
       }
       throw SimError("sensitivity parameter '" + p.name +
                      "': no case field '" + p.field + "'");
     }
-    plan.parameters.push_back(p);
+    plan->parameters.push_back(p);
   }
+}
 
-  // each case's nominal values, read from the case as loaded
-  for (const std::string& name : options.cases) {
-    SweepCase c;
-    c.scene = sim::resolve_scene(name, &c.name);
-    const sim::Case probe = sim::load_case(c.scene, options.overrides);
-    c.physics_step_s = probe.physics_step_s();
-    for (const SweepParameter& p : plan.parameters) {
-      SweepValue v;
-      switch (p.kind) {
-        case SweepKind::kField:
-          v.number = probe.config().value(*sim::find_param(p.field)).numbers.at(0);
-          break;
-        case SweepKind::kChoice:
-          v.text = probe.config().value(*sim::find_param(p.field)).text;
-          break;
-        default:
-          v.number = 1.0;
-      }
-      c.nominal.push_back(v);
+// A case by its name, with its nominal values read from the case as loaded
+// with the overrides: a field's own value, 1 for a scale.
+SweepCase plan_case(const std::string& name,
+                    const std::vector<std::string>& overrides,
+                    const std::vector<SweepParameter>& parameters) {
+  SweepCase c;
+  c.scene = sim::resolve_scene(name, &c.name);
+  const sim::Case probe = sim::load_case(c.scene, overrides);
+  c.physics_step_s = probe.physics_step_s();
+  for (const SweepParameter& p : parameters) {
+    SweepValue v;
+    switch (p.kind) {
+      case SweepKind::kField:
+        v.number = probe.config().value(*sim::find_param(p.field)).numbers.at(0);
+        break;
+      case SweepKind::kChoice:
+        v.text = probe.config().value(*sim::find_param(p.field)).text;
+        break;
+      default:
+        v.number = 1.0;
     }
-    plan.cases.push_back(c);
+    c.nominal.push_back(v);
   }
+  return c;
+}
 
+// Case by case: the nominal point, each parameter over its `count`
+// one-at-a-time levels, and the Latin hypercube's `samples` points (the
+// same unit draws for every case), numbered in that order.
+void plan_points(int count, int samples, SweepPlan* plan) {
   const auto u = latin_hypercube(static_cast<std::size_t>(samples),
-                                 plan.parameters.size(), options.seed);
-  for (std::size_t ci = 0; ci < plan.cases.size(); ++ci) {
-    const SweepCase& c = plan.cases[ci];
+                                 plan->parameters.size(), plan->options.seed);
+  for (std::size_t ci = 0; ci < plan->cases.size(); ++ci) {
+    const SweepCase& c = plan->cases[ci];
     auto add = [&](PointKind kind, int parameter,
                    const std::vector<SweepValue>& values) {
       SweepPoint pt;
-      pt.index = plan.points.size();
+      pt.index = plan->points.size();
       pt.case_index = ci;
       pt.kind = kind;
       pt.parameter = parameter;
       pt.values = values;
-      plan.points.push_back(pt);
+      plan->points.push_back(pt);
     };
     add(PointKind::kNominal, -1, c.nominal);
-    for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
-      for (const SweepValue& v : levels(plan.parameters[j], count, c.nominal[j])) {
+    for (std::size_t j = 0; j < plan->parameters.size(); ++j) {
+      for (const SweepValue& v : levels(plan->parameters[j], count, c.nominal[j])) {
         std::vector<SweepValue> values = c.nominal;
         values[j] = v;
         add(PointKind::kOneAtATime, static_cast<int>(j), values);
@@ -364,29 +369,33 @@ SweepPlan plan_sweep(const SensitivityOptions& options) {
     }
     for (const std::vector<double>& row_u : u) {
       std::vector<SweepValue> values;
-      for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
-        values.push_back(at_unit(plan.parameters[j], row_u[j]));
+      for (std::size_t j = 0; j < plan->parameters.size(); ++j) {
+        values.push_back(at_unit(plan->parameters[j], row_u[j]));
       }
       add(PointKind::kSample, -1, values);
     }
   }
+}
 
-  // the vector fields a scale multiplies, item by item, as the case has them
-  std::vector<std::vector<std::vector<double>>> scaled_items(plan.cases.size());
-  for (std::size_t ci = 0; ci < plan.cases.size(); ++ci) {
-    const sim::Case probe = sim::load_case(plan.cases[ci].scene, options.overrides);
-    for (const SweepParameter& p : plan.parameters) {
+// Every point's overrides and Omni scales (apply_values), and for a scale
+// of a vector field the case's items, as loaded, each times the value.
+void plan_settings(SweepPlan* plan) {
+  std::vector<std::vector<std::vector<double>>> scaled_items(plan->cases.size());
+  for (std::size_t ci = 0; ci < plan->cases.size(); ++ci) {
+    const sim::Case probe =
+        sim::load_case(plan->cases[ci].scene, plan->options.overrides);
+    for (const SweepParameter& p : plan->parameters) {
       scaled_items[ci].push_back(
           p.kind == SweepKind::kFieldScale
               ? probe.config().value(*sim::find_param(p.field)).numbers
               : std::vector<double>{});
     }
   }
-  for (SweepPoint& pt : plan.points) {
-    const SweepCase& c = plan.cases[pt.case_index];
-    apply_values(plan, c, &pt);
-    for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
-      const SweepParameter& p = plan.parameters[j];
+  for (SweepPoint& pt : plan->points) {
+    const SweepCase& c = plan->cases[pt.case_index];
+    apply_values(*plan, c, &pt);
+    for (std::size_t j = 0; j < plan->parameters.size(); ++j) {
+      const SweepParameter& p = plan->parameters[j];
       if (p.kind != SweepKind::kFieldScale || same(pt.values[j], c.nominal[j])) {
         continue;
       }
@@ -397,9 +406,12 @@ SweepPlan plan_sweep(const SensitivityOptions& options) {
       pt.overrides.push_back(p.field + "=" + items);
     }
   }
+}
 
-  // the definition the id hashes: what was asked and every point's settings
+// The definition the id hashes: what was asked and every point's settings.
+nlohmann::ordered_json plan_definition(const SweepPlan& plan) {
   using IdJson = nlohmann::ordered_json;
+  const SensitivityOptions& options = plan.options;
   IdJson params = IdJson::array();
   for (const SweepParameter& p : plan.parameters) {
     IdJson j = {{"name", p.name}, {"field", p.field.empty() ? IdJson() : IdJson(p.field)}};
@@ -424,16 +436,36 @@ SweepPlan plan_sweep(const SensitivityOptions& options) {
   }
   IdJson case_names = IdJson::array();
   for (const SweepCase& c : plan.cases) case_names.push_back(c.name);
-  plan.definition = {{"software", options.software},
-                     {"cases", case_names},
-                     {"quick", options.quick},
-                     {"levels", count},
-                     {"samples", samples},
-                     {"seed", options.seed},
-                     {"set", options.overrides},
-                     {"parameters", params},
-                     {"omitted", plan.omitted},
-                     {"points", points}};
+  return {{"software", options.software},
+          {"cases", case_names},
+          {"quick", options.quick},
+          {"levels", options.levels},
+          {"samples", options.samples},
+          {"seed", options.seed},
+          {"set", options.overrides},
+          {"parameters", params},
+          {"omitted", plan.omitted},
+          {"points", points}};
+}
+
+}  // namespace
+
+SweepPlan plan_sweep(const SensitivityOptions& options) {
+  SweepPlan plan;
+  plan.options = options;
+  if (options.cases.empty()) throw SimError("sensitivity: no case to sweep");
+  const int count = options.levels > 0 ? options.levels : (options.quick ? 2 : 5);
+  const int samples =
+      options.samples >= 0 ? options.samples : (options.quick ? 16 : 64);
+  plan.options.levels = count;
+  plan.options.samples = samples;
+  plan_parameters(options, &plan);
+  for (const std::string& name : options.cases) {
+    plan.cases.push_back(plan_case(name, options.overrides, plan.parameters));
+  }
+  plan_points(count, samples, &plan);
+  plan_settings(&plan);
+  plan.definition = plan_definition(plan);
   plan.id = fnv1a_hex(plan.definition.dump());
   return plan;
 }
