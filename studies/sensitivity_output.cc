@@ -201,10 +201,8 @@ struct ParameterEffect {
   SweepValue flips_at;              // the one nearest the nominal
 };
 
-}  // namespace
-
-nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
-                                        const std::vector<PointResult>& results) {
+// the table as swept, each parameter with every case's nominal value
+Json swept_parameters_json(const SweepPlan& plan) {
   Json params = Json::array();
   for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
     Json p = parameter_json(plan.parameters[j]);
@@ -214,12 +212,12 @@ nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
     p["nominal"] = nominal;
     params.push_back(p);
   }
-  Json cases = Json::array();
-  for (const SweepCase& c : plan.cases) {
-    cases.push_back({{"name", c.name}, {"scene", c.scene},
-                     {"physics_step_s", c.physics_step_s}});
-  }
+  return params;
+}
 
+// every point: what it set, its RMS path error, error and claims
+Json points_json(const SweepPlan& plan,
+                 const std::vector<PointResult>& results) {
   Json points = Json::array();
   for (const SweepPoint& pt : plan.points) {
     const PointResult& r = results[pt.index];
@@ -245,120 +243,182 @@ nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
          {"error", r.error.empty() ? Json() : Json(r.error)},
          {"claims", claims}});
   }
+  return points;
+}
 
+// What parameter j does to a claim of case ci (points cp) one at a time:
+// the share of its levels (and the nominal) where the claim holds, the
+// claim's value and margin ranges, the levels where the verdict differs
+// from the nominal's and, of those, the one nearest the nominal.
+ParameterEffect parameter_effect(const SweepPlan& plan,
+                                 const std::vector<PointResult>& results,
+                                 std::size_t ci, const CasePoints& cp,
+                                 const std::string& claim, bool nominal_holds,
+                                 std::size_t j) {
+  const SweepCase& c = plan.cases[ci];
+  ParameterEffect e;
+  e.parameter = j;
+  std::vector<std::size_t> pts = {cp.nominal};
+  pts.insert(pts.end(), cp.by_parameter[j].begin(), cp.by_parameter[j].end());
+  e.holds_fraction = fraction_holding(pts, results, claim);
+  double best = INFINITY;
+  for (std::size_t i : pts) {
+    const ClaimOutcome* o = find_claim(results[i], claim);
+    if (o != nullptr) {
+      e.value.add(o->value);
+      e.margin.add(claim_margin(*o));
+    }
+    if (i == cp.nominal || holds(results[i], claim) == nominal_holds) {
+      continue;
+    }
+    const SweepValue& v = plan.points[i].values[j];
+    e.flipped.push_back(v);
+    const double d = distance(plan.parameters[j], v, c.nominal[j]);
+    if (d < best) {
+      best = d;
+      e.flips_at = v;
+    }
+  }
+  return e;
+}
+
+// the parameters that flip the claim somewhere in their range, the widest
+// margin span first, each with where it flips
+Json depends_on_json(const SweepPlan& plan,
+                     const std::vector<ParameterEffect>& effects) {
+  std::vector<ParameterEffect> deciding;
+  for (const ParameterEffect& e : effects) {
+    if (!e.flipped.empty()) deciding.push_back(e);
+  }
+  std::stable_sort(deciding.begin(), deciding.end(),
+                   [](const ParameterEffect& a, const ParameterEffect& b) {
+                     return a.margin.span() > b.margin.span();
+                   });
+  Json depends_on = Json::array();
+  for (const ParameterEffect& e : deciding) {
+    Json levels = Json::array();
+    for (const SweepValue& v : e.flipped) levels.push_back(value_json(v));
+    depends_on.push_back({{"parameter", plan.parameters[e.parameter].name},
+                          {"flips_at", value_json(e.flips_at)},
+                          {"flipped_at", levels},
+                          {"value_range", e.value.json()},
+                          {"margin_range", e.margin.json()}});
+  }
+  return depends_on;
+}
+
+// The points a case's holds fractions and spread are taken over: the
+// sample's if it has one, else the one-at-a-time points with the nominal.
+struct CaseSpan {
+  CasePoints cp;
+  std::vector<std::size_t> oat;  // the nominal and every one-at-a-time point
+  bool sampled = false;
+  const std::vector<std::size_t>& over() const {
+    return sampled ? cp.sample : oat;
+  }
+};
+
+CaseSpan case_span(const SweepPlan& plan, std::size_t ci) {
+  CaseSpan span;
+  span.cp = case_points(plan, ci);
+  span.oat = {span.cp.nominal};
+  for (const auto& v : span.cp.by_parameter) {
+    span.oat.insert(span.oat.end(), v.begin(), v.end());
+  }
+  span.sampled = !span.cp.sample.empty();
+  return span;
+}
+
+// One claim of case ci: its threshold, value at the nominal, holds
+// fractions (over the span, one at a time, over the sample), what it
+// depends on and each parameter's effect.
+Json claim_json(const SweepPlan& plan, const std::vector<PointResult>& results,
+                std::size_t ci, const CaseSpan& span, const ClaimView& cv) {
+  const CasePoints& cp = span.cp;
+  const PointResult& nom = results[cp.nominal];
+  const ClaimOutcome* nc = find_claim(nom, cv.name);
+  const bool nominal_holds = holds(nom, cv.name);
+  std::vector<ParameterEffect> effects;
+  for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
+    effects.push_back(
+        parameter_effect(plan, results, ci, cp, cv.name, nominal_holds, j));
+  }
+  Json by_parameter = Json::array();
+  for (const ParameterEffect& e : effects) {
+    by_parameter.push_back({{"parameter", plan.parameters[e.parameter].name},
+                            {"holds_fraction", sens_number_or_null(e.holds_fraction)},
+                            {"value_range", e.value.json()},
+                            {"margin_range", e.margin.json()}});
+  }
+  const bool sampled = span.sampled;
+  return {{"case", plan.cases[ci].name},
+          {"name", cv.name},
+          {"unit", cv.unit},
+          {"comparison", cv.comparison},
+          {"threshold", cv.threshold},
+          {"value_at_nominal", nc != nullptr ? sens_number_or_null(nc->value) : Json()},
+          {"holds_at_nominal", nominal_holds},
+          {"holds_fraction",
+           sens_number_or_null(fraction_holding(span.over(), results, cv.name))},
+          {"holds_fraction_over", sampled ? "sample" : "one_at_a_time"},
+          {"holds_fraction_one_at_a_time",
+           sens_number_or_null(fraction_holding(span.oat, results, cv.name))},
+          {"holds_fraction_sample",
+           sampled ? sens_number_or_null(fraction_holding(cp.sample, results, cv.name))
+                   : Json()},
+          {"depends_on", depends_on_json(plan, effects)},
+          {"by_parameter", by_parameter}};
+}
+
+// The modelling spread of case ci's RMS path error: its range over the
+// span, and each parameter's range one at a time, the widest first.
+Json spread_json(const SweepPlan& plan, const std::vector<PointResult>& results,
+                 std::size_t ci, const CaseSpan& span) {
+  const CasePoints& cp = span.cp;
+  Range all;
+  for (std::size_t i : span.over()) all.add(results[i].rms_path_error_mm);
+  Json by_parameter = Json::array();
+  std::vector<std::pair<double, Json>> ranked;
+  for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
+    Range r;
+    r.add(results[cp.nominal].rms_path_error_mm);
+    for (std::size_t i : cp.by_parameter[j]) r.add(results[i].rms_path_error_mm);
+    ranked.push_back({r.span(), Json{{"parameter", plan.parameters[j].name},
+                                     {"range_mm", r.json()},
+                                     {"spread_mm", r.span()}}});
+  }
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (auto& r : ranked) by_parameter.push_back(r.second);
+  return {{"case", plan.cases[ci].name},
+          {"rms_path_error_mm",
+           {{"nominal", sens_number_or_null(results[cp.nominal].rms_path_error_mm)},
+            {"min", sens_number_or_null(all.lo)},
+            {"max", sens_number_or_null(all.hi)},
+            {"spread", all.span()},
+            {"over", span.sampled ? "sample" : "one_at_a_time"},
+            {"points", span.over().size()}}},
+          {"by_parameter", by_parameter}};
+}
+
+}  // namespace
+
+nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
+                                        const std::vector<PointResult>& results) {
+  Json cases = Json::array();
+  for (const SweepCase& c : plan.cases) {
+    cases.push_back({{"name", c.name}, {"scene", c.scene},
+                     {"physics_step_s", c.physics_step_s}});
+  }
   Json claims = Json::array();
   Json spreads = Json::array();
   for (std::size_t ci = 0; ci < plan.cases.size(); ++ci) {
-    const SweepCase& c = plan.cases[ci];
-    const CasePoints cp = case_points(plan, ci);
-    std::vector<std::size_t> oat = {cp.nominal};
-    for (const auto& v : cp.by_parameter) oat.insert(oat.end(), v.begin(), v.end());
-    const bool sampled = !cp.sample.empty();
-    const std::vector<std::size_t>& over = sampled ? cp.sample : oat;
-
+    const CaseSpan span = case_span(plan, ci);
     for (const ClaimView& cv : case_claims(plan, ci, results)) {
-      const PointResult& nom = results[cp.nominal];
-      const ClaimOutcome* nc = find_claim(nom, cv.name);
-      const bool nominal_holds = holds(nom, cv.name);
-      std::vector<ParameterEffect> effects;
-      for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
-        ParameterEffect e;
-        e.parameter = j;
-        std::vector<std::size_t> pts = {cp.nominal};
-        pts.insert(pts.end(), cp.by_parameter[j].begin(), cp.by_parameter[j].end());
-        e.holds_fraction = fraction_holding(pts, results, cv.name);
-        double best = INFINITY;
-        for (std::size_t i : pts) {
-          const ClaimOutcome* o = find_claim(results[i], cv.name);
-          if (o != nullptr) {
-            e.value.add(o->value);
-            e.margin.add(claim_margin(*o));
-          }
-          if (i == cp.nominal || holds(results[i], cv.name) == nominal_holds) {
-            continue;
-          }
-          const SweepValue& v = plan.points[i].values[j];
-          e.flipped.push_back(v);
-          const double d = distance(plan.parameters[j], v, c.nominal[j]);
-          if (d < best) {
-            best = d;
-            e.flips_at = v;
-          }
-        }
-        effects.push_back(e);
-      }
-      Json by_parameter = Json::array();
-      for (const ParameterEffect& e : effects) {
-        by_parameter.push_back({{"parameter", plan.parameters[e.parameter].name},
-                                {"holds_fraction", sens_number_or_null(e.holds_fraction)},
-                                {"value_range", e.value.json()},
-                                {"margin_range", e.margin.json()}});
-      }
-      std::vector<ParameterEffect> deciding;
-      for (const ParameterEffect& e : effects) {
-        if (!e.flipped.empty()) deciding.push_back(e);
-      }
-      std::stable_sort(deciding.begin(), deciding.end(),
-                       [](const ParameterEffect& a, const ParameterEffect& b) {
-                         return a.margin.span() > b.margin.span();
-                       });
-      Json depends_on = Json::array();
-      for (const ParameterEffect& e : deciding) {
-        Json levels = Json::array();
-        for (const SweepValue& v : e.flipped) levels.push_back(value_json(v));
-        depends_on.push_back({{"parameter", plan.parameters[e.parameter].name},
-                              {"flips_at", value_json(e.flips_at)},
-                              {"flipped_at", levels},
-                              {"value_range", e.value.json()},
-                              {"margin_range", e.margin.json()}});
-      }
-      claims.push_back(
-          {{"case", c.name},
-           {"name", cv.name},
-           {"unit", cv.unit},
-           {"comparison", cv.comparison},
-           {"threshold", cv.threshold},
-           {"value_at_nominal", nc != nullptr ? sens_number_or_null(nc->value) : Json()},
-           {"holds_at_nominal", nominal_holds},
-           {"holds_fraction", sens_number_or_null(fraction_holding(over, results, cv.name))},
-           {"holds_fraction_over", sampled ? "sample" : "one_at_a_time"},
-           {"holds_fraction_one_at_a_time",
-            sens_number_or_null(fraction_holding(oat, results, cv.name))},
-           {"holds_fraction_sample",
-            sampled ? sens_number_or_null(fraction_holding(cp.sample, results, cv.name))
-                    : Json()},
-           {"depends_on", depends_on},
-           {"by_parameter", by_parameter}});
+      claims.push_back(claim_json(plan, results, ci, span, cv));
     }
-
-    // the modelling spread of the RMS path error
-    Range all;
-    for (std::size_t i : over) all.add(results[i].rms_path_error_mm);
-    Json by_parameter = Json::array();
-    std::vector<std::pair<double, Json>> ranked;
-    for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
-      Range r;
-      r.add(results[cp.nominal].rms_path_error_mm);
-      for (std::size_t i : cp.by_parameter[j]) r.add(results[i].rms_path_error_mm);
-      ranked.push_back({r.span(), Json{{"parameter", plan.parameters[j].name},
-                                       {"range_mm", r.json()},
-                                       {"spread_mm", r.span()}}});
-    }
-    std::stable_sort(ranked.begin(), ranked.end(),
-                     [](const auto& a, const auto& b) { return a.first > b.first; });
-    for (auto& r : ranked) by_parameter.push_back(r.second);
-    spreads.push_back(
-        {{"case", c.name},
-         {"rms_path_error_mm",
-          {{"nominal", sens_number_or_null(results[cp.nominal].rms_path_error_mm)},
-           {"min", sens_number_or_null(all.lo)},
-           {"max", sens_number_or_null(all.hi)},
-           {"spread", all.span()},
-           {"over", sampled ? "sample" : "one_at_a_time"},
-           {"points", over.size()}}},
-         {"by_parameter", by_parameter}});
+    spreads.push_back(spread_json(plan, results, ci, span));
   }
-
   std::size_t failed = 0;
   for (const PointResult& r : results) failed += r.error.empty() ? 0 : 1;
   return {{"study", "sensitivity"},
@@ -370,13 +430,13 @@ nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
           {"samples", plan.options.samples},
           {"seed", plan.options.seed},
           {"set", plan.options.overrides},
-          {"parameters", params},
+          {"parameters", swept_parameters_json(plan)},
           {"omitted", plan.omitted},
           {"point_count", plan.points.size()},
           {"failed_points", failed},
           {"claims", claims},
           {"modelling_spread", spreads},
-          {"points", points}};
+          {"points", points_json(plan, results)}};
 }
 
 std::string sensitivity_csv(const SweepPlan& plan,
