@@ -278,14 +278,17 @@ nlohmann::json extremes_json(const ExtremesResult& r) {
   };
 }
 
-void write_extremes_files(const ExtremesResult& r, const std::string& out_dir) {
+std::vector<std::string> write_extremes_files(const ExtremesResult& r,
+                                              const std::string& out_dir) {
   const fs::path dir(out_dir);
-  output::write_file_atomically((dir / "extremes.csv").string(),
-                                extremes_csv(r.scenarios));
-  output::write_file_atomically((dir / "extremes.json").string(),
-                                extremes_json(r).dump(2) + "\n");
-  output::write_file_atomically((dir / "extremes.svg").string(),
+  const std::vector<std::string> files = {(dir / "extremes.csv").string(),
+                                          (dir / "extremes.json").string(),
+                                          (dir / "extremes.svg").string()};
+  output::write_file_atomically(files[0], extremes_csv(r.scenarios));
+  output::write_file_atomically(files[1], extremes_json(r).dump(2) + "\n");
+  output::write_file_atomically(files[2],
                                 output::chart_grid_svg(extremes_figure(r)));
+  return files;
 }
 
 }  // namespace vmh::studies

@@ -406,7 +406,7 @@ ExtremesResult run_extremes_study(const ExtremesOptions& o) {
   if (series) {
     made_here.keep = true;
     series->commit();
-    write_extremes_files(result, o.out_dir);
+    result.files = write_extremes_files(result, o.out_dir);
   }
   return result;
 }

@@ -194,19 +194,24 @@ struct ExtremesResult {
   std::vector<ExtremeResult> scenarios;  // in the order run
   std::vector<EnergyCurve> energy;       // one per scenario, same order
   double wall_time_s = 0.0;              // the whole study
+  // the three files written (write_extremes_files; out_dir), not the
+  // series' folder beside them; extremes_json leaves them out
+  std::vector<std::string> files;
   bool all_pass() const;
 };
 
 // Runs every scenario of extreme_scenarios() (or those named in `only`) on
-// `jobs` threads, and, if out_dir is not empty, writes out_dir/extremes.csv,
-// out_dir/extremes.json (extremes_json), out_dir/extremes.svg (the
-// observer's E(t), one panel per scenario) and out_dir/extremes/<name>.csv
-// (a time series per scenario). Throws SimError naming the scenario on bad
-// input. The series go into a private folder beside out_dir/extremes as
-// they are made (output::OutputSet) and replace that folder whole at the
-// end, just before the three files: should_stop (polled last before that)
-// throws runtime::Interrupted with nothing written and no folder of its own
-// left, and out_dir/extremes then holds only the series of the scenarios run.
+// `jobs` threads, and, if out_dir is not empty, writes out_dir/extremes/
+// <name>.csv (a time series per scenario) and the study's files
+// (write_extremes_files): out_dir/extremes.csv, out_dir/extremes.json
+// (extremes_json) and out_dir/extremes.svg (the observer's E(t), one panel
+// per scenario), keeping the three files' paths in `files`. Throws SimError
+// naming the scenario on bad input. The series go into a private folder
+// beside out_dir/extremes as they are made (output::OutputSet) and replace
+// that folder whole at the end, just before the three files: should_stop
+// (polled last before that) throws runtime::Interrupted with nothing
+// written and no folder of its own left, and out_dir/extremes then holds
+// only the series of the scenarios run.
 ExtremesResult run_extremes_study(const ExtremesOptions& options);
 
 // ---------------------------------------------------------------- output
@@ -229,8 +234,11 @@ EnergyCurve thin_energy(const std::vector<TickRecord>& rows,
 // end of the script dashed, the rest window the study judges shaded, the
 // outcome under the name in its colour
 output::ChartGrid extremes_figure(const ExtremesResult& r);
-// writes the study's files under out_dir (not the per-scenario series)
-void write_extremes_files(const ExtremesResult& r, const std::string& out_dir);
+// out_dir/extremes.csv, extremes.json and extremes.svg, each replaced
+// whole (not the per-scenario series, which run_extremes_study puts in);
+// returns their paths
+std::vector<std::string> write_extremes_files(const ExtremesResult& r,
+                                              const std::string& out_dir);
 
 }  // namespace vmh::studies
 

@@ -310,8 +310,7 @@ LeannessResult run_leanness_study(const LeannessOptions& o) {
   // the last poll: from here leanness.csv goes in
   runtime::throw_if_stop_asked(o.should_stop);
   if (!o.out_dir.empty()) {
-    result.files = {output::write_file_in(o.out_dir, "leanness.csv",
-                                          leanness_csv(result))};
+    result.files = write_leanness_files(result, o.out_dir);
   }
   return result;
 }
@@ -434,6 +433,11 @@ nlohmann::ordered_json leanness_json(const LeannessResult& r) {
   };
   if (!r.files.empty()) j["files"] = r.files;
   return j;
+}
+
+std::vector<std::string> write_leanness_files(const LeannessResult& r,
+                                              const std::string& out_dir) {
+  return {output::write_file_in(out_dir, "leanness.csv", leanness_csv(r))};
 }
 
 }  // namespace vmh::studies

@@ -126,9 +126,10 @@ struct LeannessResult {
   std::vector<std::string> files;  // the paths written (out_dir)
 };
 
-// Runs the study and, with out_dir, writes out_dir/leanness.csv. Throws
-// SimError on a bad scene or override, before any run; runtime::Interrupted
-// when should_stop says so, before anything is written.
+// Runs the study and, with out_dir, writes its file (write_leanness_files).
+// Throws SimError on a bad scene or override, before any run;
+// runtime::Interrupted when should_stop says so, before anything is
+// written.
 LeannessResult run_leanness_study(const LeannessOptions& options);
 
 // one row per case and variant, units in the column names
@@ -137,6 +138,10 @@ std::string leanness_csv(const LeannessResult& r);
 // What the command line prints: every case's variants, the median CPU
 // slowdown of each variant over the cases, and the files written.
 nlohmann::ordered_json leanness_json(const LeannessResult& r);
+
+// out_dir/leanness.csv; returns its path
+std::vector<std::string> write_leanness_files(const LeannessResult& r,
+                                              const std::string& out_dir);
 
 }  // namespace vmh::studies
 

@@ -212,7 +212,9 @@ struct StabilityResult {
 };
 
 // Runs the bisection (study_stability) or the map (stability_map) and, with
-// out_dir, writes the files. Throws SimError on bad parameters.
+// out_dir, writes the files (write_stability_files). Throws SimError on bad
+// parameters; runtime::Interrupted when should_stop says so, before any
+// file is written.
 StabilityResult run_stability_study(const StabilityOptions& options);
 
 // ---------------------------------------------------------------- output
