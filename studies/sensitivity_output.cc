@@ -1,29 +1,23 @@
 // The sensitivity study's outputs: sensitivity.json (the sweep, its points,
 // per claim what it depends on, the modelling spread), sensitivity.csv, the
-// figure, and the partial files of shards with their merge.
+// figure and the files. The partial files of shards and their merge are
+// sensitivity_shards.cc.
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
 #include <string>
 
 #include "output/output_file.h"
+#include "studies/sensitivity_detail.h"
 #include "studies/sensitivity_study.h"
 
 namespace vmh::studies {
 namespace {
 
 using Json = nlohmann::ordered_json;
-using sim::SimError;
-namespace fs = std::filesystem;
-
-Json sens_number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(); }
-double number_from(const nlohmann::json& j) {
-  return j.is_number() ? j.get<double>() : std::nan("");
-}
+using detail::sens_number_or_null;
 
 Json value_json(const SweepValue& v) {
   return v.text.empty() ? Json(v.number) : Json(v.text);
@@ -64,6 +58,10 @@ bool parse_scale(const std::string& s, SweepScale* k) {
   return false;
 }
 
+}  // namespace
+
+namespace detail {
+
 Json parameter_json(const SweepParameter& p) {
   Json j = {{"name", p.name},
             {"kind", kind_name(p.kind)},
@@ -100,6 +98,10 @@ SweepParameter parameter_from(const nlohmann::json& j) {
   p.optional = j.at("optional").get<bool>();
   return p;
 }
+
+}  // namespace detail
+
+namespace {
 
 // one case's claim as the sweep saw it
 struct ClaimView {
@@ -205,7 +207,7 @@ struct ParameterEffect {
 Json swept_parameters_json(const SweepPlan& plan) {
   Json params = Json::array();
   for (std::size_t j = 0; j < plan.parameters.size(); ++j) {
-    Json p = parameter_json(plan.parameters[j]);
+    Json p = detail::parameter_json(plan.parameters[j]);
     p.erase("optional");
     Json nominal = Json::object();
     for (const SweepCase& c : plan.cases) nominal[c.name] = value_json(c.nominal[j]);
@@ -542,154 +544,6 @@ std::vector<std::string> write_sensitivity_files(
           output::write_file_in(out_dir, "sensitivity.csv",
                                 sensitivity_csv(plan, results)),
           output::write_file_in(out_dir, "sensitivity.svg", svg)};
-}
-
-nlohmann::ordered_json partial_json(const SweepPlan& plan, int k, int n,
-                                    const std::vector<PointResult>& results) {
-  const SensitivityOptions& o = plan.options;
-  Json table = Json();
-  if (!o.parameters.empty()) {
-    table = Json::array();
-    for (const SweepParameter& p : o.parameters) table.push_back(parameter_json(p));
-  }
-  Json rs = Json::array();
-  for (const PointResult& r : results) {
-    Json claims = Json::array();
-    for (const ClaimOutcome& c : r.claims) {
-      claims.push_back({{"name", c.name}, {"value", sens_number_or_null(c.value)},
-                        {"threshold", c.threshold}, {"comparison", c.comparison},
-                        {"unit", c.unit}, {"pass", c.pass}});
-    }
-    rs.push_back({{"index", r.index},
-                  {"error", r.error},
-                  {"rms_path_error_mm", sens_number_or_null(r.rms_path_error_mm)},
-                  {"claims", claims}});
-  }
-  return {{"study", "sensitivity-partial"},
-          {"software", o.software},
-          {"sweep_id", plan.id},
-          {"shard", {{"k", k}, {"n", n}}},
-          {"point_count", plan.points.size()},
-          {"options",
-           {{"cases", o.cases},
-            {"quick", o.quick},
-            {"levels", o.levels},
-            {"samples", o.samples},
-            {"seed", o.seed},
-            {"set", o.overrides},
-            {"parameters", table}}},
-          {"results", rs}};
-}
-
-std::string write_partial_file(const SweepPlan& plan, int k, int n,
-                               const std::vector<PointResult>& results,
-                               const std::string& out_dir) {
-  return output::write_file_in(out_dir, "sensitivity.partial.json",
-                               partial_json(plan, k, n, results).dump(2) + "\n");
-}
-
-SensitivityOptions partial_options(const nlohmann::json& partial,
-                                   const std::string& where) {
-  try {
-    if (partial.at("study") != "sensitivity-partial") {
-      throw std::runtime_error("not a sensitivity.partial.json");
-    }
-    const nlohmann::json& o = partial.at("options");
-    SensitivityOptions s;
-    s.cases = o.at("cases").get<std::vector<std::string>>();
-    s.quick = o.at("quick").get<bool>();
-    s.levels = o.at("levels").get<int>();
-    s.samples = o.at("samples").get<int>();
-    s.seed = o.at("seed").get<std::uint64_t>();
-    s.overrides = o.at("set").get<std::vector<std::string>>();
-    if (o.at("parameters").is_array()) {
-      for (const auto& p : o.at("parameters")) s.parameters.push_back(parameter_from(p));
-    }
-    s.software = partial.at("software").get<std::string>();
-    return s;
-  } catch (const std::exception& e) {
-    throw SimError(where + ": not a sensitivity shard's file (" + e.what() + ")");
-  }
-}
-
-std::vector<PointResult> partial_results(const nlohmann::json& partial,
-                                         const std::string& where) {
-  std::vector<PointResult> out;
-  try {
-    for (const auto& r : partial.at("results")) {
-      PointResult p;
-      p.index = r.at("index").get<std::size_t>();
-      p.error = r.at("error").get<std::string>();
-      p.rms_path_error_mm = number_from(r.at("rms_path_error_mm"));
-      for (const auto& c : r.at("claims")) {
-        p.claims.push_back({c.at("name").get<std::string>(), number_from(c.at("value")),
-                            c.at("threshold").get<double>(),
-                            c.at("comparison").get<std::string>(),
-                            c.at("unit").get<std::string>(), c.at("pass").get<bool>()});
-      }
-      out.push_back(p);
-    }
-  } catch (const std::exception& e) {
-    throw SimError(where + ": a result that cannot be read (" + e.what() + ")");
-  }
-  return out;
-}
-
-Merged merge_partials(const std::vector<std::string>& paths,
-                      const std::string& software) {
-  if (paths.empty()) throw SimError("merge: no partial files given");
-  std::vector<std::pair<std::string, nlohmann::json>> files;
-  for (const std::string& given : paths) {
-    std::string path = given;
-    if (fs::is_directory(path)) path = (fs::path(path) / "sensitivity.partial.json").string();
-    std::ifstream in(path);
-    if (!in) throw SimError(path + ": cannot read");
-    nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-    if (j.is_discarded()) throw SimError(path + ": not JSON");
-    files.emplace_back(path, std::move(j));
-  }
-  SensitivityOptions options = partial_options(files[0].second, files[0].first);
-  const std::string first_software = options.software;
-  options.software = software;
-  Merged m;
-  m.plan = plan_sweep(options);
-  std::vector<bool> seen(m.plan.points.size(), false);
-  m.results.resize(m.plan.points.size());
-  for (const auto& [path, j] : files) {
-    partial_options(j, path);  // the same checks on every file
-    const std::string id = j.value("sweep_id", std::string());
-    if (id != m.plan.id) {
-      throw SimError(path + ": sweep " + id + " is not the sweep " + m.plan.id +
-                     " that " + files[0].first + " describes (planned again by " +
-                     software + "; the file was written by " +
-                     j.value("software", std::string("?")) + ", the first by " +
-                     first_software + ")");
-    }
-    for (PointResult& r : partial_results(j, path)) {
-      if (r.index >= seen.size()) {
-        throw SimError(path + ": point " + std::to_string(r.index) + " is not in the sweep");
-      }
-      if (seen[r.index]) {
-        throw SimError(path + ": point " + std::to_string(r.index) +
-                       " is given twice (the same shard merged twice?)");
-      }
-      seen[r.index] = true;
-      m.results[r.index] = std::move(r);
-    }
-  }
-  std::string missing;
-  std::size_t n_missing = 0;
-  for (std::size_t i = 0; i < seen.size(); ++i) {
-    if (seen[i]) continue;
-    if (++n_missing <= 5) missing += " " + std::to_string(i);
-  }
-  if (n_missing > 0) {
-    throw SimError("merge: " + std::to_string(n_missing) + " of " +
-                   std::to_string(seen.size()) + " points missing (" +
-                   missing.substr(1) + (n_missing > 5 ? " ..." : "") +
-                   "): a shard was not given");
-  }
-  return m;
 }
 
 }  // namespace vmh::studies

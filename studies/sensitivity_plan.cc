@@ -1,7 +1,8 @@
 // The sensitivity study's plan: the table of what is uncertain, the sweep's
 // points (one at a time and a Latin hypercube) and its shards. The runs of
-// the points are sensitivity_study.cc; the outputs (JSON, CSV, figure,
-// partial files and their merge) sensitivity_output.cc.
+// the points are sensitivity_study.cc; the outputs (JSON, CSV, figure)
+// sensitivity_output.cc; the partial files and their merge
+// sensitivity_shards.cc.
 #include "studies/sensitivity_study.h"
 
 #include <algorithm>

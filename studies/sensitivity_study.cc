@@ -1,7 +1,8 @@
 // The sensitivity study's runs: each point of a planned sweep
 // (sensitivity_plan.cc) run as a case with its overrides and Omni edits,
 // its claims judged, on worker threads. The outputs are
-// sensitivity_output.cc.
+// sensitivity_output.cc, the shards' files and their merge
+// sensitivity_shards.cc.
 #include "studies/sensitivity_study.h"
 
 #include <algorithm>

@@ -192,6 +192,9 @@ std::vector<std::string> write_sensitivity_files(
     const SweepPlan& plan, const std::vector<PointResult>& results,
     const std::string& out_dir);
 
+// ---------------------------------------------------------------- shards
+// (sensitivity_shards.cc)
+
 // A shard's results and the sweep's identity (sensitivity.partial.json).
 nlohmann::ordered_json partial_json(const SweepPlan& plan, int k, int n,
                                     const std::vector<PointResult>& results);
