@@ -105,45 +105,6 @@ std::vector<std::string> case_names(const std::vector<std::string>& given) {
   return out;
 }
 
-studies::SweepPlan plan_or_usage(const studies::SensitivityOptions& o) {
-  try {
-    return studies::plan_sweep(o);
-  } catch (const sim::SimError& e) {
-    throw UsageError(std::string("study sensitivity: ") + e.what());
-  }
-}
-
-// what the command line prints: per claim its holds fraction and the
-// parameters that flip it, the spread of the path error, the files
-Json summary(const nlohmann::ordered_json& full,
-             const std::vector<std::string>& files) {
-  Json claims = Json::array();
-  for (const auto& c : full.at("claims")) {
-    Json deps = Json::array();
-    for (const auto& d : c.at("depends_on")) {
-      deps.push_back({{"parameter", d.at("parameter")}, {"flips_at", d.at("flips_at")}});
-    }
-    claims.push_back({{"case", c.at("case")},
-                      {"name", c.at("name")},
-                      {"holds_at_nominal", c.at("holds_at_nominal")},
-                      {"holds_fraction", c.at("holds_fraction")},
-                      {"holds_fraction_one_at_a_time", c.at("holds_fraction_one_at_a_time")},
-                      {"depends_on", deps}});
-  }
-  Json spread = Json::array();
-  for (const auto& s : full.at("modelling_spread")) {
-    spread.push_back({{"case", s.at("case")}, {"rms_path_error_mm", s.at("rms_path_error_mm")}});
-  }
-  return {{"study", "sensitivity"},
-          {"sweep_id", full.at("sweep_id")},
-          {"point_count", full.at("point_count")},
-          {"failed_points", full.at("failed_points")},
-          {"omitted", full.at("omitted")},
-          {"claims", claims},
-          {"modelling_spread", spread},
-          {"files", files}};
-}
-
 void run(const SensitivityCli& o) {
   // SIGINT / SIGTERM only set a flag for the whole run, which the sweep
   // polls (cli/study_files.h): exit 130 / 143, --out as it was
@@ -165,46 +126,30 @@ void run(const SensitivityCli& o) {
     }
   }
   studies::SensitivityOptions opt;
-  opt.cases = case_names(o.cases);
-  opt.quick = o.quick;
-  opt.samples = o.samples;
-  opt.seed = o.seed;
-  opt.overrides = o.sets;
-  opt.software = kSoftware;
+  opt.sweep.cases = case_names(o.cases);
+  opt.sweep.quick = o.quick;
+  opt.sweep.samples = o.samples;
+  opt.sweep.seed = o.seed;
+  opt.sweep.overrides = o.sets;
+  opt.sweep.software = kSoftware;
+  opt.jobs = o.jobs > 0 ? o.jobs : output::core_count();
+  opt.shard_k = k;
+  opt.shard_n = n;
+  opt.out_dir = o.out;
+  opt.should_stop = study_stop();
   check_out(o.out);
-  const studies::SweepPlan plan = plan_or_usage(opt);
-
-  const std::vector<std::size_t> which =
-      n > 0 ? studies::shard_points(plan.points.size(), k, n)
-            : std::vector<std::size_t>{};
-  const std::size_t count = n > 0 ? which.size() : plan.points.size();
-  std::vector<studies::PointResult> results;
-  {
-    output::Progress bar("study sensitivity", count);
-    results = run_stoppable("study sensitivity", [&] {
-      return studies::run_points(plan, which,
-                                 o.jobs > 0 ? o.jobs : output::core_count(),
-                                 bar.part(0), study_stop());
-    });
+  studies::SensitivityResult r;
+  try {
+    // the bar (on a terminal) is finished before the JSON
+    output::Progress bar("study sensitivity", 0);
+    opt.progress = bar.part(0);
+    r = run_stoppable("study sensitivity",
+                      [&] { return studies::run_sensitivity_study(opt); });
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("study sensitivity: ") + e.what());
   }
-  // the last poll: from here the files go in
-  runtime::throw_if_stopped("study sensitivity", "; nothing written");
-  if (n > 0) {
-    const std::string path = studies::write_partial_file(plan, k, n, results, o.out);
-    throw_if_stopped_after_writing("study sensitivity", o.out);
-    std::cout << dump_readable(Json{{"study", "sensitivity"},
-                                    {"sweep_id", plan.id},
-                                    {"shard", {{"k", k}, {"n", n}}},
-                                    {"point_count", plan.points.size()},
-                                    {"points_run", results.size()},
-                                    {"files", {path}}})
-              << '\n';
-    return;
-  }
-  const auto files = studies::write_sensitivity_files(plan, results, o.out);
   throw_if_stopped_after_writing("study sensitivity", o.out);
-  std::cout << dump_readable(summary(studies::sensitivity_json(plan, results), files))
-            << '\n';
+  std::cout << dump_readable(studies::sensitivity_json(r)) << '\n';
 }
 
 void merge(const MergeCli& o) {
@@ -213,17 +158,16 @@ void merge(const MergeCli& o) {
   StopSignals signals;
   if (o.parts.empty()) throw UsageError("study merge: give the shards' folders or files");
   check_out(o.out);
-  studies::Merged m;
+  studies::SensitivityResult m;
   try {
     m = studies::merge_partials(o.parts, kSoftware);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("study merge: ") + e.what());
   }
   runtime::throw_if_stopped("study merge", "; nothing written");
-  const auto files = studies::write_sensitivity_files(m.plan, m.results, o.out);
+  m.files = studies::write_sensitivity_files(m, o.out);
   throw_if_stopped_after_writing("study merge", o.out);
-  std::cout << dump_readable(summary(studies::sensitivity_json(m.plan, m.results), files))
-            << '\n';
+  std::cout << dump_readable(studies::sensitivity_json(m)) << '\n';
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // The sensitivity study's outputs: sensitivity.json (the sweep, its points,
 // per claim what it depends on, the modelling spread), sensitivity.csv, the
-// figure and the files. The partial files of shards and their merge are
-// sensitivity_shards.cc.
+// figure, what the command line prints, and the files. The partial files of
+// shards and their merge are sensitivity_shards.cc.
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -405,8 +405,8 @@ Json spread_json(const SweepPlan& plan, const std::vector<PointResult>& results,
 
 }  // namespace
 
-nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
-                                        const std::vector<PointResult>& results) {
+nlohmann::ordered_json sensitivity_file_json(
+    const SweepPlan& plan, const std::vector<PointResult>& results) {
   Json cases = Json::array();
   for (const SweepCase& c : plan.cases) {
     cases.push_back({{"name", c.name}, {"scene", c.scene},
@@ -535,14 +535,67 @@ output::ChartGrid sensitivity_chart(const SweepPlan& plan,
   return grid;
 }
 
-std::vector<std::string> write_sensitivity_files(
-    const SweepPlan& plan, const std::vector<PointResult>& results,
-    const std::string& out_dir) {
-  const std::string svg = output::chart_grid_svg(sensitivity_chart(plan, results));
-  return {output::write_file_in(out_dir, "sensitivity.json",
-                                sensitivity_json(plan, results).dump(2) + "\n"),
+namespace {
+
+// The whole sweep as the command line prints it: sensitivity.json's
+// summary (per claim its holds fractions and the parameters that flip it,
+// with where; each case's spread of the RMS path error) and the files.
+Json sweep_summary_json(const Json& full,
+                        const std::vector<std::string>& files) {
+  Json claims = Json::array();
+  for (const auto& c : full.at("claims")) {
+    Json deps = Json::array();
+    for (const auto& d : c.at("depends_on")) {
+      deps.push_back({{"parameter", d.at("parameter")}, {"flips_at", d.at("flips_at")}});
+    }
+    claims.push_back({{"case", c.at("case")},
+                      {"name", c.at("name")},
+                      {"holds_at_nominal", c.at("holds_at_nominal")},
+                      {"holds_fraction", c.at("holds_fraction")},
+                      {"holds_fraction_one_at_a_time", c.at("holds_fraction_one_at_a_time")},
+                      {"depends_on", deps}});
+  }
+  Json spread = Json::array();
+  for (const auto& s : full.at("modelling_spread")) {
+    spread.push_back({{"case", s.at("case")}, {"rms_path_error_mm", s.at("rms_path_error_mm")}});
+  }
+  return {{"study", "sensitivity"},
+          {"sweep_id", full.at("sweep_id")},
+          {"point_count", full.at("point_count")},
+          {"failed_points", full.at("failed_points")},
+          {"omitted", full.at("omitted")},
+          {"claims", claims},
+          {"modelling_spread", spread},
+          {"files", files}};
+}
+
+}  // namespace
+
+nlohmann::ordered_json sensitivity_json(const SensitivityResult& r) {
+  if (r.is_shard()) {
+    return {{"study", "sensitivity"},
+            {"sweep_id", r.plan.id},
+            {"shard", {{"k", r.shard_k}, {"n", r.shard_n}}},
+            {"point_count", r.plan.points.size()},
+            {"points_run", r.results.size()},
+            {"files", r.files}};
+  }
+  return sweep_summary_json(sensitivity_file_json(r.plan, r.results), r.files);
+}
+
+std::vector<std::string> write_sensitivity_files(const SensitivityResult& r,
+                                                 const std::string& out_dir) {
+  if (r.is_shard()) {
+    return {write_partial_file(r.plan, r.shard_k, r.shard_n, r.results,
+                               out_dir)};
+  }
+  const std::string svg =
+      output::chart_grid_svg(sensitivity_chart(r.plan, r.results));
+  const std::string json =
+      sensitivity_file_json(r.plan, r.results).dump(2) + "\n";
+  return {output::write_file_in(out_dir, "sensitivity.json", json),
           output::write_file_in(out_dir, "sensitivity.csv",
-                                sensitivity_csv(plan, results)),
+                                sensitivity_csv(r.plan, r.results)),
           output::write_file_in(out_dir, "sensitivity.svg", svg)};
 }
 

@@ -1,7 +1,7 @@
 // The sensitivity study's plan: the table of what is uncertain, the sweep's
 // points (one at a time and a Latin hypercube) and its shards. The runs of
-// the points are sensitivity_study.cc; the outputs (JSON, CSV, figure)
-// sensitivity_output.cc; the partial files and their merge
+// the points and the study are sensitivity_study.cc; the outputs (JSON,
+// CSV, figure) sensitivity_output.cc; the partial files and their merge
 // sensitivity_shards.cc.
 #include "studies/sensitivity_study.h"
 
@@ -298,7 +298,7 @@ namespace {
 // The table swept: options.parameters or sweep_parameters(), each row
 // checked; an optional row whose case field this build lacks goes into
 // plan->omitted, a required one is an error.
-void plan_parameters(const SensitivityOptions& options, SweepPlan* plan) {
+void plan_parameters(const SweepOptions& options, SweepPlan* plan) {
   const std::vector<SweepParameter>& table =
       options.parameters.empty() ? sweep_parameters() : options.parameters;
   for (const SweepParameter& p : table) {
@@ -412,7 +412,7 @@ void plan_settings(SweepPlan* plan) {
 // The definition the id hashes: what was asked and every point's settings.
 nlohmann::ordered_json plan_definition(const SweepPlan& plan) {
   using IdJson = nlohmann::ordered_json;
-  const SensitivityOptions& options = plan.options;
+  const SweepOptions& options = plan.options;
   IdJson params = IdJson::array();
   for (const SweepParameter& p : plan.parameters) {
     IdJson j = {{"name", p.name}, {"field", p.field.empty() ? IdJson() : IdJson(p.field)}};
@@ -451,7 +451,7 @@ nlohmann::ordered_json plan_definition(const SweepPlan& plan) {
 
 }  // namespace
 
-SweepPlan plan_sweep(const SensitivityOptions& options) {
+SweepPlan plan_sweep(const SweepOptions& options) {
   SweepPlan plan;
   plan.options = options;
   if (options.cases.empty()) throw SimError("sensitivity: no case to sweep");

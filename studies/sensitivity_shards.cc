@@ -1,7 +1,7 @@
 // The sensitivity study's shards: a shard's partial file
 // (sensitivity.partial.json: the sweep's identity, its options and the
 // shard's results), the options and results read back from one, and the
-// merge of a sweep's partial files.
+// merge of a sweep's partial files into the whole sweep's result.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -31,7 +31,7 @@ double number_from(const nlohmann::json& j) {
 
 nlohmann::ordered_json partial_json(const SweepPlan& plan, int k, int n,
                                     const std::vector<PointResult>& results) {
-  const SensitivityOptions& o = plan.options;
+  const SweepOptions& o = plan.options;
   Json table = Json();
   if (!o.parameters.empty()) {
     table = Json::array();
@@ -73,14 +73,14 @@ std::string write_partial_file(const SweepPlan& plan, int k, int n,
                                partial_json(plan, k, n, results).dump(2) + "\n");
 }
 
-SensitivityOptions partial_options(const nlohmann::json& partial,
-                                   const std::string& where) {
+SweepOptions partial_options(const nlohmann::json& partial,
+                             const std::string& where) {
   try {
     if (partial.at("study") != "sensitivity-partial") {
       throw std::runtime_error("not a sensitivity.partial.json");
     }
     const nlohmann::json& o = partial.at("options");
-    SensitivityOptions s;
+    SweepOptions s;
     s.cases = o.at("cases").get<std::vector<std::string>>();
     s.quick = o.at("quick").get<bool>();
     s.levels = o.at("levels").get<int>();
@@ -120,8 +120,8 @@ std::vector<PointResult> partial_results(const nlohmann::json& partial,
   return out;
 }
 
-Merged merge_partials(const std::vector<std::string>& paths,
-                      const std::string& software) {
+SensitivityResult merge_partials(const std::vector<std::string>& paths,
+                                 const std::string& software) {
   if (paths.empty()) throw SimError("merge: no partial files given");
   std::vector<std::pair<std::string, nlohmann::json>> files;
   for (const std::string& given : paths) {
@@ -133,10 +133,10 @@ Merged merge_partials(const std::vector<std::string>& paths,
     if (j.is_discarded()) throw SimError(path + ": not JSON");
     files.emplace_back(path, std::move(j));
   }
-  SensitivityOptions options = partial_options(files[0].second, files[0].first);
+  SweepOptions options = partial_options(files[0].second, files[0].first);
   const std::string first_software = options.software;
   options.software = software;
-  Merged m;
+  SensitivityResult m;
   m.plan = plan_sweep(options);
   std::vector<bool> seen(m.plan.points.size(), false);
   m.results.resize(m.plan.points.size());

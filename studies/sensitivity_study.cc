@@ -1,8 +1,8 @@
 // The sensitivity study's runs: each point of a planned sweep
 // (sensitivity_plan.cc) run as a case with its overrides and Omni edits,
-// its claims judged, on worker threads. The outputs are
-// sensitivity_output.cc, the shards' files and their merge
-// sensitivity_shards.cc.
+// its claims judged, on worker threads, and the study (the sweep or a
+// shard, planned, run and written). The outputs are sensitivity_output.cc,
+// the shards' files and their merge sensitivity_shards.cc.
 #include "studies/sensitivity_study.h"
 
 #include <algorithm>
@@ -97,6 +97,24 @@ std::vector<PointResult> run_points(const SweepPlan& plan,
                        });
   if (stopped) throw runtime::Interrupted();
   return out;
+}
+
+SensitivityResult run_sensitivity_study(const SensitivityOptions& o) {
+  SensitivityResult r;
+  r.plan = plan_sweep(o.sweep);
+  r.shard_k = o.shard_k;
+  r.shard_n = o.shard_n;
+  const std::vector<std::size_t> which =
+      r.is_shard() ? shard_points(r.plan.points.size(), o.shard_k, o.shard_n)
+                   : std::vector<std::size_t>{};
+  // the bar's total before the first point ends
+  const std::size_t count = r.is_shard() ? which.size() : r.plan.points.size();
+  if (o.progress && count > 0) o.progress(0, count);
+  r.results = run_points(r.plan, which, o.jobs, o.progress, o.should_stop);
+  // the last poll: from here the files go in
+  runtime::throw_if_stop_asked(o.should_stop);
+  if (!o.out_dir.empty()) r.files = write_sensitivity_files(r, o.out_dir);
+  return r;
 }
 
 double claim_margin(const ClaimOutcome& c) {

@@ -103,7 +103,9 @@ struct SweepCase {
   std::vector<SweepValue> nominal;       // one per parameter of the plan
 };
 
-struct SensitivityOptions {
+// What the sweep is: the plan's definition, which a partial file keeps
+// (partial_options) so that its merge can plan the sweep again.
+struct SweepOptions {
   std::vector<std::string> cases;        // case names (resolve_scene)
   bool quick = false;
   int samples = -1;                      // -1: 16 with quick, 64 otherwise
@@ -118,7 +120,7 @@ struct SensitivityOptions {
 
 // The sweep as planned: its cases, parameters, points and identity.
 struct SweepPlan {
-  SensitivityOptions options;
+  SweepOptions options;  // levels and samples as planned
   std::vector<SweepParameter> parameters;  // those swept
   std::vector<std::string> omitted;        // optional ones left out, and why
   std::vector<SweepCase> cases;
@@ -129,7 +131,7 @@ struct SweepPlan {
 
 // Plans the sweep. Throws SimError on an unknown case, a bad override, a
 // missing required field or a bad table row, before anything runs.
-SweepPlan plan_sweep(const SensitivityOptions& options);
+SweepPlan plan_sweep(const SweepOptions& options);
 
 // Shard k of n (1 <= k <= n): the points i with i mod n == k - 1.
 std::vector<std::size_t> shard_points(std::size_t points, int k, int n);
@@ -174,11 +176,59 @@ std::vector<PointResult> run_points(const SweepPlan& plan,
 // "<=" (>= 0 where it holds), over |threshold| when that is not 0.
 double claim_margin(const ClaimOutcome& c);
 
+// ---------------------------------------------------------------- the study
+
+// What `vmhaptics study sensitivity` runs: the sweep, or one shard of it.
+struct SensitivityOptions {
+  SweepOptions sweep;
+  int jobs = 1;  // points run at once (run_points; <= 0: one per core)
+  // shard k of n (shard_points): only its points run, and the partial file
+  // is written; 0 of 0: the whole sweep
+  int shard_k = 0, shard_n = 0;
+  // where the files go (write_sensitivity_files); empty: nothing written
+  std::string out_dir;
+  // called from the workers with (points done, points), and once with
+  // (0, points) before the first starts; not set: nothing
+  output::ProgressFn progress;
+  // polled from the workers between points and every tick, and last before
+  // the files are written: runtime::Interrupted, nothing written
+  runtime::StopFn should_stop;
+};
+
+struct SensitivityResult {
+  SweepPlan plan;
+  int shard_k = 0, shard_n = 0;      // the options', 0 of 0: the whole sweep
+  std::vector<PointResult> results;  // the points run, by index
+  std::vector<std::string> files;    // the paths written (out_dir)
+  bool is_shard() const { return shard_n > 0; }
+};
+
+// Plans the sweep (plan_sweep), runs its points or the shard's (run_points)
+// and, with out_dir, writes the files (write_sensitivity_files). Throws
+// SimError on bad input (plan_sweep's), before any point runs;
+// runtime::Interrupted when should_stop says so, before any file is
+// written. A point whose run failed is a result (PointResult::error).
+SensitivityResult run_sensitivity_study(const SensitivityOptions& options);
+
+// What the command line prints. The whole sweep: per claim its holds
+// fractions and the parameters that flip it, each case's spread of the RMS
+// path error, and the files. A shard: the sweep's id, the shard, how many
+// points it ran, and its file.
+nlohmann::ordered_json sensitivity_json(const SensitivityResult& r);
+
+// The whole sweep: out_dir/sensitivity.json, .csv and .svg; a shard:
+// out_dir/sensitivity.partial.json. Returns their paths.
+std::vector<std::string> write_sensitivity_files(const SensitivityResult& r,
+                                                 const std::string& out_dir);
+
+// ---------------------------------------------------------------- output
+// (sensitivity_output.cc)
+
 // sensitivity.json: the sweep, the points, per claim its holds fraction and
 // what it depends on, and the modelling spread of the RMS path error.
 // `results` must hold every point once.
-nlohmann::ordered_json sensitivity_json(const SweepPlan& plan,
-                                        const std::vector<PointResult>& results);
+nlohmann::ordered_json sensitivity_file_json(
+    const SweepPlan& plan, const std::vector<PointResult>& results);
 // one row per point and claim, units in the column names
 std::string sensitivity_csv(const SweepPlan& plan,
                             const std::vector<PointResult>& results);
@@ -186,11 +236,6 @@ std::string sensitivity_csv(const SweepPlan& plan,
 // sweep, zero where it stops holding
 output::ChartGrid sensitivity_chart(const SweepPlan& plan,
                                     const std::vector<PointResult>& results);
-
-// out_dir/sensitivity.json, .csv and .svg; returns their paths
-std::vector<std::string> write_sensitivity_files(
-    const SweepPlan& plan, const std::vector<PointResult>& results,
-    const std::string& out_dir);
 
 // ---------------------------------------------------------------- shards
 // (sensitivity_shards.cc)
@@ -205,8 +250,8 @@ std::string write_partial_file(const SweepPlan& plan, int k, int n,
 
 // The options a partial file was planned from (to plan the sweep again).
 // Throws SimError naming the file on a file that is not one.
-SensitivityOptions partial_options(const nlohmann::json& partial,
-                                   const std::string& where);
+SweepOptions partial_options(const nlohmann::json& partial,
+                             const std::string& where);
 std::vector<PointResult> partial_results(const nlohmann::json& partial,
                                          const std::string& where);
 
@@ -215,13 +260,10 @@ std::vector<PointResult> partial_results(const nlohmann::json& partial,
 // and checks that every file names that plan's id and that every point is
 // there exactly once. Throws SimError naming the file or the points
 // otherwise. `software`: the running program's, which must plan the same
-// sweep.
-struct Merged {
-  SweepPlan plan;
-  std::vector<PointResult> results;  // by index
-};
-Merged merge_partials(const std::vector<std::string>& paths,
-                      const std::string& software);
+// sweep. The result is the whole sweep's, every point by index, as if one
+// run had made it, with no files yet (write_sensitivity_files).
+SensitivityResult merge_partials(const std::vector<std::string>& paths,
+                                 const std::string& software);
 
 }  // namespace vmh::studies
 

@@ -1,6 +1,7 @@
 // The sensitivity study (studies/sensitivity_study.h): the slicing into
 // shards, the plan, what a parameter that cannot matter and one that is
-// known to flip a claim show, and merge == unsharded, value by value.
+// known to flip a claim show, merge == unsharded, value by value, and the
+// study's files.
 #include "studies/sensitivity_study.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <string>
 
@@ -60,7 +62,7 @@ TEST(SensitivityMargin, PositiveWhereTheClaimHolds) {
 }
 
 TEST(SensitivityPlan, DefaultTableQuickSweepOfCase2) {
-  SensitivityOptions o;
+  SweepOptions o;
   o.cases = {"case2"};
   o.quick = true;
   const SweepPlan plan = plan_sweep(o);
@@ -108,7 +110,7 @@ TEST(SensitivityPlan, DefaultTableQuickSweepOfCase2) {
 }
 
 TEST(SensitivityPlan, BadInputThrowsBeforeAnyRun) {
-  SensitivityOptions o;
+  SweepOptions o;
   o.cases = {"case9"};
   EXPECT_THROW(plan_sweep(o), sim::SimError);
   o.cases = {"case2"};
@@ -144,7 +146,7 @@ SweepParameter field(const char* name, SweepScale scale, double low,
 // K_rot = 0.05 N m/rad two of its four fail); the seed of a jitter that is
 // off cannot change anything.
 TEST(SensitivityStudy, WristStiffnessFlipsCase2AndAnInertSeedDoesNot) {
-  SensitivityOptions o;
+  SweepOptions o;
   o.cases = {"case2"};
   o.samples = 0;
   o.levels = 2;
@@ -153,7 +155,7 @@ TEST(SensitivityStudy, WristStiffnessFlipsCase2AndAnInertSeedDoesNot) {
   const SweepPlan plan = plan_sweep(o);
   ASSERT_EQ(plan.points.size(), 3u);  // nominal, K_rot 0.05, seed 2
   const auto results = run_points(plan, {}, 0);
-  const nlohmann::ordered_json j = sensitivity_json(plan, results);
+  const nlohmann::ordered_json j = sensitivity_file_json(plan, results);
   ASSERT_FALSE(j.at("claims").empty());
   int flipped_by_k_rot = 0;
   for (const auto& c : j.at("claims")) {
@@ -182,7 +184,7 @@ TEST(SensitivityStudy, WristStiffnessFlipsCase2AndAnInertSeedDoesNot) {
 // A short sweep (2 s script) run whole and in three shards, merged through
 // the partial files: the same JSON and CSV, to the last bit.
 TEST(SensitivityStudy, MergeOfThreeShardsEqualsTheUnshardedRun) {
-  SensitivityOptions o;
+  SweepOptions o;
   o.cases = {"case2"};
   o.samples = 3;
   o.levels = 2;
@@ -203,12 +205,11 @@ TEST(SensitivityStudy, MergeOfThreeShardsEqualsTheUnshardedRun) {
     parts.push_back(write_partial_file(plan, k, 3, part,
                                        (dir / ("part" + std::to_string(k))).string()));
   }
-  const Merged m = merge_partials({(dir / "part2").string(), parts[0],
-                                   (dir / "part3").string()},
-                                  "test");
+  const SensitivityResult m = merge_partials(
+      {(dir / "part2").string(), parts[0], (dir / "part3").string()}, "test");
   EXPECT_EQ(m.plan.id, plan.id);
-  EXPECT_EQ(sensitivity_json(m.plan, m.results).dump(),
-            sensitivity_json(plan, whole).dump());
+  EXPECT_EQ(sensitivity_file_json(m.plan, m.results).dump(),
+            sensitivity_file_json(plan, whole).dump());
   EXPECT_EQ(sensitivity_csv(m.plan, m.results), sensitivity_csv(plan, whole));
 
   // refused: a shard missing, a shard twice, another program's sweep
@@ -216,6 +217,51 @@ TEST(SensitivityStudy, MergeOfThreeShardsEqualsTheUnshardedRun) {
   EXPECT_THROW(merge_partials({parts[0], parts[1], parts[2], parts[1]}, "test"),
                sim::SimError);
   EXPECT_THROW(merge_partials(parts, "another version"), sim::SimError);
+}
+
+// The study as the verb runs it: the sweep's three files, listed and
+// printed; a shard's partial file with only its points; and stopped,
+// nothing written.
+TEST(SensitivityStudy, RunWritesTheSweepsFilesOrTheShards) {
+  SensitivityOptions o;
+  o.sweep.cases = {"case2"};
+  o.sweep.samples = 0;
+  o.sweep.levels = 2;
+  o.sweep.overrides = {"duration_s=1"};
+  o.sweep.software = "test";
+  o.sweep.parameters = {field("jitter_seed", SweepScale::kInteger, 1, 2)};
+  const fs::path dir = fs::path(::testing::TempDir()) / "vmh_sensitivity_run";
+  fs::remove_all(dir);
+
+  o.out_dir = (dir / "whole").string();
+  const SensitivityResult whole = run_sensitivity_study(o);
+  EXPECT_FALSE(whole.is_shard());
+  ASSERT_EQ(whole.results.size(), 2u);  // nominal, seed 2
+  ASSERT_EQ(whole.files.size(), 3u);
+  EXPECT_EQ(fs::path(whole.files[0]).filename(), "sensitivity.json");
+  std::ifstream in(whole.files[0]);
+  const std::string text((std::istreambuf_iterator<char>(in)),
+                         std::istreambuf_iterator<char>());
+  EXPECT_EQ(text,
+            sensitivity_file_json(whole.plan, whole.results).dump(2) + "\n");
+  EXPECT_EQ(sensitivity_json(whole).at("files").size(), 3u);
+  EXPECT_EQ(sensitivity_json(whole).at("point_count"), 2);
+
+  o.shard_k = 2;
+  o.shard_n = 2;
+  o.out_dir = (dir / "part2").string();
+  const SensitivityResult part = run_sensitivity_study(o);
+  EXPECT_TRUE(part.is_shard());
+  ASSERT_EQ(part.results.size(), 1u);
+  EXPECT_EQ(part.results[0].index, 1u);
+  ASSERT_EQ(part.files.size(), 1u);
+  EXPECT_EQ(fs::path(part.files[0]).filename(), "sensitivity.partial.json");
+  EXPECT_EQ(sensitivity_json(part).at("points_run"), 1);
+
+  o.out_dir = (dir / "stopped").string();
+  o.should_stop = [] { return true; };
+  EXPECT_THROW(run_sensitivity_study(o), runtime::Interrupted);
+  EXPECT_FALSE(fs::exists(dir / "stopped"));
 }
 
 }  // namespace
