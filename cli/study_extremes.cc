@@ -102,10 +102,10 @@ void run(const ExtremesCli& o) {
 
 }  // namespace
 
-void register_study_extremes(CLI::App* study) {
+void register_study_extremes(CLI::App* study, const char* name) {
   auto o = std::make_shared<ExtremesCli>();
   CLI::App* cmd = study->add_subcommand(
-      "extremes",
+      name,
       "stiff and extreme cases (gains x10/x100, hand 10-5000 N/m, RM at the "
       "pivot, poles, gimbal singularity, full reach, +-pi, servo jitter, "
       "sensor faults): finite, |F| within the limit, bounded injected "

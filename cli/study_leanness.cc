@@ -83,10 +83,10 @@ void run(const LeannessCli& o) {
 
 }  // namespace
 
-void register_study_leanness(CLI::App* study) {
+void register_study_leanness(CLI::App* study, const char* name) {
   auto o = std::make_shared<LeannessCli>();
   CLI::App* cmd = study->add_subcommand(
-      "leanness",
+      name,
       "steps per second of each case's scene as composed against the same "
       "scene with contacts, gravity and a viewer's scene update switched on");
   cmd->add_option("--case", o->cases,

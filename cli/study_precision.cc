@@ -181,10 +181,10 @@ void run(const PrecisionCli& o) {
 
 }  // namespace
 
-void register_study_precision(CLI::App* study) {
+void register_study_precision(CLI::App* study, const char* name) {
   auto o = std::make_shared<PrecisionCli>();
   CLI::App* cmd = study->add_subcommand(
-      "precision",
+      name,
       "trajectory error against wall time for each MuJoCo integrator and a "
       "ladder of physics steps, against an RK4 reference (quantisation off)");
   cmd->add_option("--case", o->case_name,

@@ -172,10 +172,10 @@ void merge(const MergeCli& o) {
 
 }  // namespace
 
-void register_study_sensitivity(CLI::App* study) {
+void register_study_sensitivity(CLI::App* study, const char* name) {
   auto o = std::make_shared<SensitivityCli>();
   CLI::App* cmd = study->add_subcommand(
-      "sensitivity",
+      name,
       "how far each thesis claim survives what is uncertain (the hand's "
       "stiffness, damping, mass and inertia, the Omni's masses and friction, "
       "torque limits, servo period, delay): one parameter at a time and a "
@@ -203,10 +203,12 @@ void register_study_sensitivity(CLI::App* study) {
                   "write DIR/sensitivity.json, .csv and .svg (default "
                   "out/sensitivity)");
   cmd->callback([o] { run(*o); });
+}
 
+void register_study_merge(CLI::App* study, const char* name) {
   auto m = std::make_shared<MergeCli>();
   CLI::App* mc = study->add_subcommand(
-      "merge",
+      name,
       "join the partial files of `study sensitivity --shard K/N` into the "
       "files one unsharded run writes (refused unless they are one sweep, "
       "every point once)");

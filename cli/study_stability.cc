@@ -203,10 +203,10 @@ void run(const StabilityCli& o) {
 
 }  // namespace
 
-void register_study_stability(CLI::App* study) {
+void register_study_stability(CLI::App* study, const char* name) {
   auto o = std::make_shared<StabilityCli>();
   CLI::App* cmd = study->add_subcommand(
-      "stability",
+      name,
       "critical stiffness K_crit of a sampled-data virtual wall on a 1-DOF "
       "slider (MuJoCo, zero-order hold at T, physics at h << T), by "
       "bisection on the growth of the oscillation, against Gil et al.'s "
