@@ -69,15 +69,18 @@ PointResult run_point(const SweepPlan& plan, std::size_t index,
   return r;
 }
 
+std::vector<std::size_t> all_points(const SweepPlan& plan) {
+  std::vector<std::size_t> all(plan.points.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return all;
+}
+
 std::vector<PointResult> run_points(const SweepPlan& plan,
                                     const std::vector<std::size_t>& which,
                                     int jobs,
                                     const output::ProgressFn& progress,
                                     const runtime::StopFn& stop) {
-  std::vector<std::size_t> list = which;
-  if (list.empty()) {
-    for (std::size_t i = 0; i < plan.points.size(); ++i) list.push_back(i);
-  }
+  const std::vector<std::size_t>& list = which;
   std::vector<PointResult> out(list.size());
   std::atomic<std::size_t> done{0};
   std::atomic<bool> stopped{false};
@@ -104,12 +107,12 @@ SensitivityResult run_sensitivity_study(const SensitivityOptions& o) {
   r.plan = plan_sweep(o.sweep);
   r.shard_k = o.shard_k;
   r.shard_n = o.shard_n;
+  // a shard past the last point (k > the plan's points) runs none
   const std::vector<std::size_t> which =
       r.is_shard() ? shard_points(r.plan.points.size(), o.shard_k, o.shard_n)
-                   : std::vector<std::size_t>{};
+                   : all_points(r.plan);
   // the bar's total before the first point ends
-  const std::size_t count = r.is_shard() ? which.size() : r.plan.points.size();
-  if (o.progress && count > 0) o.progress(0, count);
+  if (o.progress && !which.empty()) o.progress(0, which.size());
   r.results = run_points(r.plan, which, o.jobs, o.progress, o.should_stop);
   // the last poll: from here the files go in
   runtime::throw_if_stop_asked(o.should_stop);

@@ -161,7 +161,11 @@ struct PointResult {
 PointResult run_point(const SweepPlan& plan, std::size_t index,
                       const runtime::StopFn& stop = {});
 
-// Runs the points `which` (all: empty) on `jobs` threads, in index order.
+// Every point of the plan, in index order (what an unsharded run runs).
+std::vector<std::size_t> all_points(const SweepPlan& plan);
+
+// Runs the points `which` (none: an empty list; all: all_points(plan)) on
+// `jobs` threads, in index order.
 // `stop` (if set) is polled from the workers between points and every
 // tick: once it says so, no point starts, those running end at their next
 // tick, and runtime::Interrupted is thrown (nothing is written here either

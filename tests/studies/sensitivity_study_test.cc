@@ -154,7 +154,7 @@ TEST(SensitivityStudy, WristStiffnessFlipsCase2AndAnInertSeedDoesNot) {
                   field("jitter_seed", SweepScale::kInteger, 1, 2)};
   const SweepPlan plan = plan_sweep(o);
   ASSERT_EQ(plan.points.size(), 3u);  // nominal, K_rot 0.05, seed 2
-  const auto results = run_points(plan, {}, 0);
+  const auto results = run_points(plan, all_points(plan), 0);
   const nlohmann::ordered_json j = sensitivity_file_json(plan, results);
   ASSERT_FALSE(j.at("claims").empty());
   int flipped_by_k_rot = 0;
@@ -195,7 +195,7 @@ TEST(SensitivityStudy, MergeOfThreeShardsEqualsTheUnshardedRun) {
   const SweepPlan plan = plan_sweep(o);
   // nominal; K 50 and 400; delay 2 (low and high, 0 is the nominal); 3 samples
   ASSERT_EQ(plan.points.size(), 1u + 2u + 1u + 3u);
-  const auto whole = run_points(plan, {}, 2);
+  const auto whole = run_points(plan, all_points(plan), 2);
 
   const fs::path dir = fs::path(::testing::TempDir()) / "vmh_sensitivity_merge";
   fs::remove_all(dir);
@@ -257,6 +257,24 @@ TEST(SensitivityStudy, RunWritesTheSweepsFilesOrTheShards) {
   ASSERT_EQ(part.files.size(), 1u);
   EXPECT_EQ(fs::path(part.files[0]).filename(), "sensitivity.partial.json");
   EXPECT_EQ(sensitivity_json(part).at("points_run"), 1);
+
+  // three shards of two points: the third has none and runs none (it ran
+  // the whole sweep once, taking its empty list for "all"), and the three
+  // merge into the unsharded run
+  std::vector<std::string> thirds;
+  for (int k = 1; k <= 3; ++k) {
+    o.shard_k = k;
+    o.shard_n = 3;
+    o.out_dir = (dir / ("third" + std::to_string(k))).string();
+    const SensitivityResult third = run_sensitivity_study(o);
+    ASSERT_EQ(third.results.size(), k == 3 ? 0u : 1u) << "shard " << k;
+    EXPECT_EQ(sensitivity_json(third).at("points_run"), k == 3 ? 0 : 1);
+    ASSERT_EQ(third.files.size(), 1u);
+    thirds.push_back(third.files[0]);
+  }
+  const SensitivityResult merged = merge_partials(thirds, "test");
+  EXPECT_EQ(sensitivity_file_json(merged.plan, merged.results).dump(),
+            sensitivity_file_json(whole.plan, whole.results).dump());
 
   o.out_dir = (dir / "stopped").string();
   o.should_stop = [] { return true; };
