@@ -173,17 +173,16 @@ std::string check_out(const std::string& out, const std::vector<Recording>& recs
   return p.string();
 }
 
-void compare(const CompareOptions& o) {
-  if (o.dirs.empty()) throw UsageError("compare: give at least one recording directory");
-  // SIGINT / SIGTERM only set a flag from here on (device/stop_signal.h),
-  // polled between recordings and sections and before the set is put in
-  // place: a stopped compare leaves --out as it was
-  StopSignals signals;
-  const std::string nothing = "; nothing written";
+const char kNothing[] = "; nothing written";
+
+// each directory's recording, in the order given, with the note on its
+// analysis window on stderr; a directory that is not a recording is a
+// UsageError
+std::vector<Recording> load_recordings(const std::vector<std::string>& dirs) {
   std::vector<Recording> recs;
   try {
-    for (const std::string& d : o.dirs) {
-      runtime::throw_if_stopped("compare", nothing);
+    for (const std::string& d : dirs) {
+      runtime::throw_if_stopped("compare", kNothing);
       recs.push_back(bringup::load_recording(d));
       if (const std::string note = bringup::window_note(recs.back()); !note.empty()) {
         std::cerr << "compare: " << note << '\n';
@@ -192,163 +191,254 @@ void compare(const CompareOptions& o) {
   } catch (const bringup::RecordingError& e) {
     throw UsageError(std::string("compare: ") + e.what());
   }
-  runtime::throw_if_stopped("compare", nothing);
+  return recs;
+}
 
-  // the set: each recording's figures in <its name>/ of a private folder,
-  // which replaces --out whole once compare.json is beside them
-  std::unique_ptr<output::OutputSet> set;
-  std::string out_dir;
-  std::vector<std::string> folder_names;  // of each recording's figures
-  if (!o.out.empty()) {
-    out_dir = check_out(o.out, recs);
+// The set: each recording's figures in <its name>/ of a private folder,
+// which replaces --out whole once compare.json is beside them. Without
+// --out there is none, and nothing is written.
+class CompareOutput {
+ public:
+  CompareOutput(const std::string& out, const std::vector<Recording>& recs) {
+    if (out.empty()) return;
+    out_dir_ = check_out(out, recs);
     try {
-      set = std::make_unique<output::OutputSet>(out_dir);
+      set_ = std::make_unique<output::OutputSet>(out_dir_);
     } catch (const std::runtime_error& e) {
-      throw UsageError("compare: --out '" + o.out + "': " + e.what());
+      throw UsageError("compare: --out '" + out + "': " + e.what());
     }
     std::set<std::string> taken{"compare.json"};
     for (const Recording& r : recs) {
-      folder_names.push_back(figure_folder_name(r.dir, &taken));
+      folder_names_.push_back(figure_folder_name(r.dir, &taken));
     }
   }
-  // where recording i's figures are written now (empty: none), and the
-  // name they will have once the set is in place
-  auto figure_dir = [&](std::size_t i) -> std::string {
-    if (!set) return {};
-    return (fs::path(set->temp_dir()) / folder_names[i]).string();
-  };
-  auto shown = [&](const std::string& written) -> std::string {
-    if (!set) return written;
-    const std::string tmp = set->temp_dir() + "/";
+
+  bool active() const { return set_ != nullptr; }
+  const std::string& dir() const { return out_dir_; }
+
+  // where recording i's figures are written now (empty: none)
+  std::string figure_dir(std::size_t i) const {
+    if (!set_) return {};
+    return (fs::path(set_->temp_dir()) / folder_names_[i]).string();
+  }
+
+  // the name a written file will have once the set is in place
+  std::string shown(const std::string& written) const {
+    if (!set_) return written;
+    const std::string tmp = set_->temp_dir() + "/";
     return written.rfind(tmp, 0) == 0
-               ? (fs::path(out_dir) / written.substr(tmp.size())).string()
+               ? (fs::path(out_dir_) / written.substr(tmp.size())).string()
                : written;
-  };
-
-  std::vector<CompareSection> sections;
-  // The readings' map and the kinematics are judged on the recording that
-  // moves the joints most (the workspace tour): a motor test moves little,
-  // and a fit of the geometry to a few poses can explain a sign away as an
-  // offset. Recordings that move at least half as much are judged too; the
-  // map found applies to every recording (one device, one codec).
-  std::vector<double> excitation(recs.size(), 0.0);
-  std::size_t richest = recs.size();
-  for (std::size_t i = 0; i < recs.size(); ++i) {
-    excitation[i] = joint_excursion_rad(recs[i]);
-    if (recs[i].has_transform() &&
-        (richest == recs.size() || excitation[i] > excitation[richest])) {
-      richest = i;
-    }
   }
+
+  // recording i's figure folder once the set is in place, or null
+  Json figures_dir_json(std::size_t i) const {
+    return set_ ? Json((fs::path(out_dir_) / folder_names_[i]).string())
+                : Json(nullptr);
+  }
+
+  // compare.json beside the figures, and the set in place of --out
+  void commit(const Json& out) {
+    if (!set_) return;
+    set_->write("compare.json", dump_readable(out) + "\n");
+    set_->commit();
+  }
+
+ private:
+  std::unique_ptr<output::OutputSet> set_;
+  std::string out_dir_;
+  std::vector<std::string> folder_names_;  // of each recording's figures
+};
+
+// The readings' map and the kinematics are judged on the recording that
+// moves the joints most (the workspace tour): a motor test moves little,
+// and a fit of the geometry to a few poses can explain a sign away as an
+// offset. Recordings that move at least half as much are judged too; the
+// map found applies to every recording (one device, one codec).
+struct KinematicsPlan {
+  std::vector<double> excitation;  // joint_excursion_rad of each recording
+  std::size_t richest = 0;  // the one judged first; recs.size(): none
   bringup::ReadingMap shared;
-  if (richest < recs.size()) shared = bringup::diagnose_readings(recs[richest]).map;
-  std::vector<bool> judge_kinematics(recs.size(), true);
+  std::vector<bool> judge;  // whose kinematics are judged
+};
+
+KinematicsPlan plan_kinematics(const std::vector<Recording>& recs) {
+  KinematicsPlan p;
+  p.excitation.assign(recs.size(), 0.0);
+  p.richest = recs.size();
   for (std::size_t i = 0; i < recs.size(); ++i) {
-    if (richest < recs.size() && i != richest &&
-        excitation[i] < 0.5 * excitation[richest]) {
-      judge_kinematics[i] = false;
+    p.excitation[i] = joint_excursion_rad(recs[i]);
+    if (recs[i].has_transform() &&
+        (p.richest == recs.size() || p.excitation[i] > p.excitation[p.richest])) {
+      p.richest = i;
     }
   }
+  if (p.richest < recs.size()) {
+    p.shared = bringup::diagnose_readings(recs[p.richest]).map;
+  }
+  p.judge.assign(recs.size(), true);
+  for (std::size_t i = 0; i < recs.size(); ++i) {
+    if (p.richest < recs.size() && i != p.richest &&
+        p.excitation[i] < 0.5 * p.excitation[p.richest]) {
+      p.judge[i] = false;
+    }
+  }
+  return p;
+}
 
+// Recording i's sections, appended in order: its kinematics (or why they
+// are judged on another), its Jacobian, a motor test's force direction, an
+// hw run's force mapping and closed loop; figures into `figs` (empty: none)
+void recording_sections(const std::vector<Recording>& recs, std::size_t i,
+                        const KinematicsPlan& plan, const std::string& scene,
+                        const std::string& figs,
+                        std::vector<CompareSection>* sections) {
+  const Recording& r = recs[i];
+  runtime::throw_if_stopped("compare", kNothing);
+  if (plan.judge[i]) {
+    sections->push_back(bringup::compare_kinematics(r, figs));
+  } else {
+    CompareSection k;
+    k.name = "kinematics";
+    k.skipped.push_back({"kinematics.*",
+                         "judged on " + recs[plan.richest].dir +
+                             ", which moves the joints more",
+                         r.dir});
+    sections->push_back(k);
+  }
+  runtime::throw_if_stopped("compare", kNothing);
+  sections->push_back(bringup::compare_jacobian(r, plan.shared, figs));
+  if (r.verb == "hw motor-test") {
+    bringup::ForceOptions fo;
+    if (!scene.empty()) fo.scene = scene;
+    runtime::throw_if_stopped("compare", kNothing);
+    sections->push_back(
+        bringup::compare_force_direction(r, plan.shared, fo, figs));
+  }
+  if (r.verb == "hw run") {
+    sections->push_back(bringup::compare_force_mapping(r));
+    bringup::ReplayOptions ro;
+    runtime::throw_if_stopped("compare", kNothing);
+    sections->push_back(bringup::compare_closed_loop(r, ro, figs));
+  }
+}
+
+// every recording's sections, in the order given; a scene or recording
+// that cannot be read is a UsageError
+std::vector<CompareSection> compare_sections(const std::vector<Recording>& recs,
+                                             const KinematicsPlan& plan,
+                                             const std::string& scene,
+                                             const CompareOutput& output) {
+  std::vector<CompareSection> sections;
   try {
     for (std::size_t i = 0; i < recs.size(); ++i) {
-      const Recording& r = recs[i];
-      const std::string figs = figure_dir(i);
-      runtime::throw_if_stopped("compare", nothing);
-      if (judge_kinematics[i]) {
-        sections.push_back(bringup::compare_kinematics(r, figs));
-      } else {
-        CompareSection k;
-        k.name = "kinematics";
-        k.skipped.push_back({"kinematics.*",
-                             "judged on " + recs[richest].dir +
-                                 ", which moves the joints more",
-                             r.dir});
-        sections.push_back(k);
-      }
-      runtime::throw_if_stopped("compare", nothing);
-      sections.push_back(bringup::compare_jacobian(r, shared, figs));
-      if (r.verb == "hw motor-test") {
-        bringup::ForceOptions fo;
-        if (!o.scene.empty()) fo.scene = o.scene;
-        runtime::throw_if_stopped("compare", nothing);
-        sections.push_back(bringup::compare_force_direction(r, shared, fo, figs));
-      }
-      if (r.verb == "hw run") {
-        sections.push_back(bringup::compare_force_mapping(r));
-        bringup::ReplayOptions ro;
-        runtime::throw_if_stopped("compare", nothing);
-        sections.push_back(bringup::compare_closed_loop(r, ro, figs));
-      }
+      recording_sections(recs, i, plan, scene, output.figure_dir(i),
+                         &sections);
     }
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("compare: ") + e.what());
   } catch (const bringup::RecordingError& e) {
     throw UsageError(std::string("compare: ") + e.what());
   }
+  return sections;
+}
 
+// What the sections found, as compare.json's arrays: every check (and how
+// many failed), skipped check, figure (by its name once in place) and
+// detail; the suspected faults with their evidence, the delays merged, and
+// their names once each in the order found.
+struct CompareFindings {
+  Json checks = Json::array(), skipped = Json::array(), evidence = Json::array();
+  Json figures = Json::array(), detail = Json::array();
+  std::vector<std::string> faults;
+  long failed = 0;
+};
+
+CompareFindings gather_findings(const std::vector<CompareSection>& sections,
+                                const CompareOutput& output) {
   std::vector<bringup::SuspectedFault> all_faults;
   for (const CompareSection& s : sections) {
     all_faults.insert(all_faults.end(), s.faults.begin(), s.faults.end());
   }
   merge_delays(&all_faults);
 
-  Json checks = Json::array(), skipped = Json::array(), evidence = Json::array();
-  Json figures = Json::array(), detail = Json::array();
-  std::vector<std::string> faults;
-  std::set<std::string> seen;
-  long failed = 0;
+  CompareFindings f;
   for (const CompareSection& s : sections) {
     for (const bringup::CompareCheck& c : s.checks) {
-      checks.push_back(bringup::check_json(c));
-      if (!c.pass) ++failed;
+      f.checks.push_back(bringup::check_json(c));
+      if (!c.pass) ++f.failed;
     }
     for (const bringup::SkippedCheck& k : s.skipped) {
-      skipped.push_back({{"name", k.name}, {"reason", k.reason}, {"recording", k.recording}});
+      f.skipped.push_back({{"name", k.name}, {"reason", k.reason}, {"recording", k.recording}});
     }
-    for (const std::string& f : s.figures) figures.push_back(shown(f));
-    if (!s.detail.empty()) detail.push_back({{"section", s.name}, {"detail", s.detail}});
+    for (const std::string& fig : s.figures) f.figures.push_back(output.shown(fig));
+    if (!s.detail.empty()) f.detail.push_back({{"section", s.name}, {"detail", s.detail}});
   }
-  for (const bringup::SuspectedFault& f : all_faults) {
-    evidence.push_back({{"name", f.name}, {"evidence", f.evidence}, {"recording", f.recording}});
-    if (seen.insert(f.name).second) faults.push_back(f.name);
+  std::set<std::string> seen;
+  for (const bringup::SuspectedFault& sf : all_faults) {
+    f.evidence.push_back({{"name", sf.name}, {"evidence", sf.evidence}, {"recording", sf.recording}});
+    if (seen.insert(sf.name).second) f.faults.push_back(sf.name);
   }
+  return f;
+}
+
+// compare.json's recordings: what each holds and where its figures went
+Json recordings_json(const std::vector<Recording>& recs,
+                     const KinematicsPlan& plan, const CompareOutput& output) {
   Json recordings = Json::array();
   for (std::size_t i = 0; i < recs.size(); ++i) {
     const Recording& r = recs[i];
     recordings.push_back({{"dir", r.dir}, {"verb", r.verb}, {"rows", r.rows},
                           {"rows_in_trace", r.rows_in_trace},
-                          {"joint_excursion_rad", excitation[i]},
+                          {"joint_excursion_rad", plan.excitation[i]},
                           {"reports_transform", r.has_transform()},
                           {"reports_jacobian", r.has_jacobian()},
-                          {"figures_dir", set ? Json((fs::path(out_dir) / folder_names[i]).string())
-                                              : Json(nullptr)}});
+                          {"figures_dir", output.figures_dir_json(i)}});
   }
-  Json out{{"recordings", recordings},
-           {"pass", failed == 0},
-           {"checks_failed", failed},
-           {"suspected_faults", faults},
-           {"checks", checks},
-           {"skipped", skipped},
-           {"evidence", evidence},
-           {"figures", figures},
-           {"detail", detail}};
-  runtime::throw_if_stopped("compare", nothing);
-  if (set) {
-    set->write("compare.json", dump_readable(out) + "\n");
-    set->commit();
-  }
+  return recordings;
+}
+
+// exit 1 when a check failed (the JSON is out first), naming the faults
+void throw_if_failed(const CompareFindings& f) {
+  if (f.failed == 0) return;
+  std::string names;
+  for (const std::string& n : f.faults) names += (names.empty() ? "" : ", ") + n;
+  throw std::runtime_error("compare: " + std::to_string(f.failed) +
+                           " check(s) failed; suspected faults: " +
+                           (names.empty() ? "none named" : names));
+}
+
+void compare(const CompareOptions& o) {
+  if (o.dirs.empty()) throw UsageError("compare: give at least one recording directory");
+  // SIGINT / SIGTERM only set a flag from here on (device/stop_signal.h),
+  // polled between recordings and sections and before the set is put in
+  // place: a stopped compare leaves --out as it was
+  StopSignals signals;
+  const std::vector<Recording> recs = load_recordings(o.dirs);
+  runtime::throw_if_stopped("compare", kNothing);
+  CompareOutput output(o.out, recs);
+  const KinematicsPlan plan = plan_kinematics(recs);
+  const std::vector<CompareSection> sections =
+      compare_sections(recs, plan, o.scene, output);
+  const CompareFindings f = gather_findings(sections, output);
+  Json out{{"recordings", recordings_json(recs, plan, output)},
+           {"pass", f.failed == 0},
+           {"checks_failed", f.failed},
+           {"suspected_faults", f.faults},
+           {"checks", f.checks},
+           {"skipped", f.skipped},
+           {"evidence", f.evidence},
+           {"figures", f.figures},
+           {"detail", f.detail}};
+  runtime::throw_if_stopped("compare", kNothing);
+  output.commit(out);
   // a signal while the set went in: it is whole, and the exit says so
   runtime::throw_if_stopped(
-      "compare", set ? "; " + out_dir + " was already written whole" : nothing);
+      "compare", output.active()
+                     ? "; " + output.dir() + " was already written whole"
+                     : kNothing);
   std::cout << dump_readable(out) << '\n';
-  if (failed > 0) {
-    std::string names;
-    for (const std::string& f : faults) names += (names.empty() ? "" : ", ") + f;
-    throw std::runtime_error("compare: " + std::to_string(failed) +
-                             " check(s) failed; suspected faults: " +
-                             (names.empty() ? "none named" : names));
-  }
+  throw_if_failed(f);
 }
 
 }  // namespace
