@@ -80,7 +80,9 @@ void print_table(const std::vector<thesis::CaseResult>& results) {
   }
 }
 
-void run(const RunOptions& o) {
+// the options that need no scene: one target or --all, --jobs, --sides,
+// --trace-sides; the runs' side options from them
+thesis::CaseRunOptions check_run_options(const RunOptions& o) {
   if (o.all == !o.target.empty()) {
     throw UsageError("run: give one case or scene, or --all");
   }
@@ -99,6 +101,11 @@ void run(const RunOptions& o) {
     throw UsageError("--trace-sides: needs --out DIR (the traces go to "
                      "DIR/<case>/trace_side_<n>.csv)");
   }
+  return run_options;
+}
+
+// the --set overrides, with --duration as duration_s's
+std::vector<std::string> overrides_of(const RunOptions& o) {
   std::vector<std::string> sets = o.sets;
   if (o.duration_given) {
     // checked here, before any scene is read, against duration_s's row of
@@ -113,8 +120,12 @@ void run(const RunOptions& o) {
     std::snprintf(text, sizeof text, "%.17g", d);
     sets.push_back(std::string("duration_s=") + text);
   }
+  return sets;
+}
 
-  // resolve every scene first, so that a bad name writes nothing
+// every run's case name and scene, resolved first, so that a bad name
+// writes nothing
+std::vector<thesis::CaseJob> resolve_runs(const RunOptions& o) {
   std::vector<std::pair<std::string, std::string>> jobs;
   try {
     if (o.all) {
@@ -130,7 +141,15 @@ void run(const RunOptions& o) {
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("run: ") + e.what());
   }
+  std::vector<thesis::CaseJob> runs;
+  for (const auto& [name, scene] : jobs) {
+    runs.push_back(thesis::CaseJob{name, scene, {}, {}, false, false});
+  }
+  return runs;
+}
 
+// --model as an absolute path (empty: the scene's own Omni)
+std::string model_of(const RunOptions& o) {
   std::string model;
   if (!o.model.empty()) {
     std::error_code ec;
@@ -139,45 +158,45 @@ void run(const RunOptions& o) {
     }
     model = std::filesystem::absolute(o.model, ec).string();
   }
-  // an --out that cannot hold the sets is found before any run
-  if (!o.out.empty()) {
-    try {
-      output::check_writable_dir(o.out);
-    } catch (const std::exception& e) {
-      throw UsageError(std::string("run: --out ") + e.what());
-    }
-  }
-  std::vector<thesis::CaseJob> runs;
-  for (const auto& [name, scene] : jobs) {
-    runs.push_back(thesis::CaseJob{name, scene, {}, {}, false, false});
-  }
+  return model;
+}
+
+// the runs, in parallel; a SIGINT or SIGTERM stops them and is a
+// SignalStop naming the sets kept
+void run_jobs(std::vector<thesis::CaseJob>* runs,
+              const std::vector<std::string>& sets, const std::string& model,
+              const RunOptions& o, const thesis::CaseRunOptions& run_options) {
+  // SIGINT / SIGTERM only set a flag (device/stop_signal.h); the runs poll
+  // it between ticks and before each file, and a stopped run's temporary
+  // set is removed by its own thread, outside the handler
+  StopSignals signals;
   {
-    // SIGINT / SIGTERM only set a flag (device/stop_signal.h); the runs poll
-    // it between ticks and before each file, and a stopped run's temporary
-    // set is removed by its own thread, outside the handler
-    StopSignals signals;
-    {
-      // a bar on stderr (terminal only) for --all; one case is one item
-      output::Progress bar("run", runs.size());
-      thesis::run_cases(
-          &runs, sets, o.out, o.jobs, model,
-          o.all ? bar.part(0) : output::ProgressFn{},
-          [&signals] { return signals.requested(); }, run_options);
-    }
-    if (signals.requested()) {
-      const int signo = signals.signal_number();
-      std::string kept;
-      for (const thesis::CaseJob& j : runs) {
-        if (j.error.empty() && !o.out.empty()) kept += " " + j.name;
-      }
-      throw runtime::SignalStop(std::string("interrupted: run stopped by ") +
-                           (signo == SIGINT ? "SIGINT" : "SIGTERM") +
-                           (o.out.empty() ? ""
-                            : kept.empty() ? "; no set written"
-                                           : "; complete sets kept:" + kept),
-                       signo);
-    }
+    // a bar on stderr (terminal only) for --all; one case is one item
+    output::Progress bar("run", runs->size());
+    thesis::run_cases(
+        runs, sets, o.out, o.jobs, model,
+        o.all ? bar.part(0) : output::ProgressFn{},
+        [&signals] { return signals.requested(); }, run_options);
   }
+  if (signals.requested()) {
+    const int signo = signals.signal_number();
+    std::string kept;
+    for (const thesis::CaseJob& j : *runs) {
+      if (j.error.empty() && !o.out.empty()) kept += " " + j.name;
+    }
+    throw runtime::SignalStop(std::string("interrupted: run stopped by ") +
+                         (signo == SIGINT ? "SIGINT" : "SIGTERM") +
+                         (o.out.empty() ? ""
+                          : kept.empty() ? "; no set written"
+                                         : "; complete sets kept:" + kept),
+                     signo);
+  }
+}
+
+// the runs' results; every failed run in one line, a UsageError if one
+// failed on its input
+std::vector<thesis::CaseResult> results_of(
+    const std::vector<thesis::CaseJob>& runs) {
   std::vector<thesis::CaseResult> results;
   std::string errors;  // every failed run, in one line
   bool bad_input = false;
@@ -192,7 +211,13 @@ void run(const RunOptions& o) {
     if (bad_input) throw UsageError(errors);
     throw std::runtime_error(errors);
   }
+  return results;
+}
 
+// the summaries as one JSON object (--json), or the table and where the
+// files went
+void print_results(const RunOptions& o,
+                   const std::vector<thesis::CaseResult>& results) {
   if (o.json) {
     nlohmann::json all = nlohmann::json::object();
     for (const thesis::CaseResult& r : results) all[r.name] = r.summary;
@@ -206,7 +231,10 @@ void run(const RunOptions& o) {
   }
   std::cout.flush();
   std::fflush(stdout);
+}
 
+// exit 1 naming every claim that failed (a partial one is not a failure)
+void throw_if_claims_failed(const std::vector<thesis::CaseResult>& results) {
   std::string failed;
   for (const thesis::CaseResult& r : results) {
     for (const thesis::Claim& c : r.claims) {
@@ -216,6 +244,25 @@ void run(const RunOptions& o) {
   if (!failed.empty()) {
     throw std::runtime_error("run: thesis claim(s) not met:" + failed);
   }
+}
+
+void run(const RunOptions& o) {
+  const thesis::CaseRunOptions run_options = check_run_options(o);
+  const std::vector<std::string> sets = overrides_of(o);
+  std::vector<thesis::CaseJob> runs = resolve_runs(o);
+  const std::string model = model_of(o);
+  // an --out that cannot hold the sets is found before any run
+  if (!o.out.empty()) {
+    try {
+      output::check_writable_dir(o.out);
+    } catch (const std::exception& e) {
+      throw UsageError(std::string("run: --out ") + e.what());
+    }
+  }
+  run_jobs(&runs, sets, model, o, run_options);
+  const std::vector<thesis::CaseResult> results = results_of(runs);
+  print_results(o, results);
+  throw_if_claims_failed(results);
 }
 
 }  // namespace
