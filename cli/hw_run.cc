@@ -97,104 +97,112 @@ Json run_on_device(runtime::OpenedDevice* dev, const std::string& scene,
                "claims"}};
 }
 
-void hw_run(const HwRunArgs& a) {
-  // SIGINT / SIGTERM only set a flag (device/stop_signal.h), for the
-  // whole verb; the session shares it
-  StopSignals signals;
+// What hw run runs, checked before anything opens: the case's name and
+// scene, its overrides (--duration as duration_s's), the device's backend
+// and the --model file (empty: none)
+struct HwRunPlan {
+  std::string name;
+  std::string scene;
+  std::vector<std::string> sets;
+  const runtime::BackendInfo* backend = nullptr;
+  std::string model_file;
+};
+
+HwRunPlan plan_hw_run(const HwRunArgs& a) {
   if (a.duration_given) {
     check_seconds("hw run: --duration", a.duration_s, 0.0, 3600.0);
   }
   if (!(a.gain_scale >= 0.0) || !std::isfinite(a.gain_scale)) {
     throw UsageError("hw run: --gain-scale must be a number >= 0");
   }
-  std::string name;
-  const std::string scene = scene_of(a.target, &name);
-  std::vector<std::string> sets = a.sets;
+  HwRunPlan p;
+  p.scene = scene_of(a.target, &p.name);
+  p.sets = a.sets;
   if (a.duration_given) {
     char text[40];
     std::snprintf(text, sizeof text, "%.17g", a.duration_s);
-    sets.push_back(std::string("duration_s=") + text);
+    p.sets.push_back(std::string("duration_s=") + text);
   }
   std::string argument;
-  const runtime::BackendInfo& backend = hw_backend(a.common, &argument);
-  if (backend.simulated && !argument.empty()) {
+  p.backend = &hw_backend(a.common, &argument);
+  if (p.backend->simulated && !argument.empty()) {
     throw UsageError("hw run: the emulator plays the run's own scene; give "
                      "it as the target, not in --device (" + a.common.device +
                      ")");
   }
   const auto model = a.common.options.find("model");
-  const std::string model_file =
+  p.model_file =
       model == a.common.options.end() ? std::string() : model->second;
-  if (!model_file.empty() && !std::filesystem::is_regular_file(model_file)) {
-    throw UsageError("--model: no such file '" + model_file + "'");
+  if (!p.model_file.empty() && !std::filesystem::is_regular_file(p.model_file)) {
+    throw UsageError("--model: no such file '" + p.model_file + "'");
   }
-  const bool out_given = a.out_option != nullptr && a.out_option->count() > 0;
-  auto set = hw_output_set("run", a.out, out_given);
+  return p;
+}
+
 #ifdef VMH_HAVE_SIM
-  // a simulated device: the case with its script and claims, loaded first
-  // so that a bad scene is refused before the device opens
-  std::unique_ptr<thesis::HwRunCase> run_case;
-  if (backend.simulated) {
-    try {
-      run_case = std::make_unique<thesis::HwRunCase>(scene, sets, model_file,
-                                                     a.gain_scale);
-    } catch (const sim::SimError& e) {
-      throw UsageError(std::string("hw run: ") + e.what());
-    }
+// a simulated device: the case with its script and claims, loaded first
+// so that a bad scene is refused before the device opens (null for a
+// real device)
+std::unique_ptr<thesis::HwRunCase> simulated_case(const HwRunPlan& p,
+                                                  double gain_scale) {
+  if (!p.backend->simulated) return nullptr;
+  try {
+    return std::make_unique<thesis::HwRunCase>(p.scene, p.sets, p.model_file,
+                                               gain_scale);
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("hw run: ") + e.what());
   }
+}
+
+// The session judged on a simulated plant's truth: the emulator's, or
+// that of a device that is not the emulator but has one behind it (the
+// project's own HD library over the emulator, docs/libhd.md), whose
+// claims are judged as the emulator's are. Null with no truth: nothing ran.
+Json run_on_truth(std::unique_ptr<thesis::HwRunCase>* run_case,
+                  const HwRunPlan& p, double gain_scale,
+                  runtime::OpenedDevice* dev,
+                  const runtime::SessionOptions& so,
+                  runtime::SessionResult* r) {
+  if (!*run_case && dev->truth != nullptr) {
+    *run_case = std::make_unique<thesis::HwRunCase>(p.scene, p.sets,
+                                                    p.model_file, gain_scale);
+  }
+  if (*run_case) return (*run_case)->run(dev, so, r);
+  return Json();
+}
 #endif
-  if (!backend.simulated) {
-    // refuse a bad scene before the device opens
-    try {
-      (void)sim::load_scene_params(scene, sets);
-    } catch (const sim::ParamError& e) {
-      throw UsageError(std::string("hw run: ") + e.what());
-    }
-  }
-  runtime::throw_if_stopped("hw run", "; nothing written");
-  // a simulated device plays the scene itself, held by its hand script
-  runtime::OpenedDevice dev = open_hw_device(
-      a.common, "case", sets, backend.simulated ? scene : std::string());
-  runtime::SessionOptions so = session_options(a.common, "run");
-  trace_into(set.get(), a.out, &so);
-  runtime::SessionResult r;
-  Json summary{{"case", name}, {"scene", scene}};
-  Json measured;
-#ifdef VMH_HAVE_SIM
-  // a device that is not the emulator but has a simulated plant's truth
-  // behind it (the project's own HD library over the emulator,
-  // docs/libhd.md): its claims are judged as the emulator's are
-  if (!run_case && dev.truth != nullptr) {
-    run_case = std::make_unique<thesis::HwRunCase>(scene, sets, model_file,
-                                                   a.gain_scale);
-  }
-  if (run_case) measured = run_case->run(&dev, so, &r);
-#endif
-  if (measured.is_null()) {
-    measured = run_on_device(&dev, scene, sets, a.gain_scale, so, &r);
-  }
+
+// summary.json: the case and scene, what was measured, the model and the
+// session
+Json summary_json(const HwRunPlan& p, const Json& measured,
+                  const runtime::SessionResult& r) {
+  Json summary{{"case", p.name}, {"scene", p.scene}};
   for (auto it = measured.begin(); it != measured.end(); ++it) {
     summary[it.key()] = it.value();
   }
-  summary["model"] = model_file.empty() ? Json(nullptr) : Json(model_file);
+  summary["model"] = p.model_file.empty() ? Json(nullptr) : Json(p.model_file);
   summary["session"] = runtime::session_json(r);
-  if (set) {
-    set->write("summary.json", dump_readable(summary) + "\n");
-    set->write("meta.json",
-               dump_readable(runtime::meta_json(
-                   &dev, r, "run",
-                   Json{{"case", name}, {"scene", scene}, {"sets", a.sets},
-                        {"gain_scale", a.gain_scale}})) +
-                   "\n");
-    set->commit();
-  }
-  std::cout << dump_readable(summary) << '\n';
-  runtime::raise_if_cut_short(r, "hw run");
-  // a signal after the session, while its claims were judged or its set
-  // went in
-  runtime::throw_if_stopped(
-      "hw run", "; after its session" +
-                    (set ? ": the set in " + a.out + " is whole" : std::string()));
+  return summary;
+}
+
+// summary.json and meta.json beside the trace, the three put in place
+// together
+void commit_set(output::OutputSet* set, runtime::OpenedDevice* dev,
+                const runtime::SessionResult& r, const HwRunPlan& p,
+                const HwRunArgs& a, const Json& summary) {
+  set->write("summary.json", dump_readable(summary) + "\n");
+  set->write("meta.json",
+             dump_readable(runtime::meta_json(
+                 dev, r, "run",
+                 Json{{"case", p.name}, {"scene", p.scene}, {"sets", a.sets},
+                      {"gain_scale", a.gain_scale}})) +
+                 "\n");
+  set->commit();
+}
+
+// exit 1 when the claims were not judged (a disturbed wall-clock
+// session) or one failed, naming them
+void throw_if_claims_failed(const Json& summary) {
   if (summary.contains("claims_judged") && !summary["claims_judged"].get<bool>()) {
     throw std::runtime_error("hw run: claims not judged: " +
                              summary["claims_not_judged_because"].get<std::string>());
@@ -209,6 +217,50 @@ void hw_run(const HwRunArgs& a) {
     }
     throw std::runtime_error("hw run: thesis claim(s) not met:" + failed);
   }
+}
+
+void hw_run(const HwRunArgs& a) {
+  // SIGINT / SIGTERM only set a flag (device/stop_signal.h), for the
+  // whole verb; the session shares it
+  StopSignals signals;
+  const HwRunPlan p = plan_hw_run(a);
+  const bool out_given = a.out_option != nullptr && a.out_option->count() > 0;
+  auto set = hw_output_set("run", a.out, out_given);
+#ifdef VMH_HAVE_SIM
+  std::unique_ptr<thesis::HwRunCase> run_case = simulated_case(p, a.gain_scale);
+#endif
+  if (!p.backend->simulated) {
+    // refuse a bad scene before the device opens
+    try {
+      (void)sim::load_scene_params(p.scene, p.sets);
+    } catch (const sim::ParamError& e) {
+      throw UsageError(std::string("hw run: ") + e.what());
+    }
+  }
+  runtime::throw_if_stopped("hw run", "; nothing written");
+  // a simulated device plays the scene itself, held by its hand script
+  runtime::OpenedDevice dev = open_hw_device(
+      a.common, "case", p.sets, p.backend->simulated ? p.scene : std::string());
+  runtime::SessionOptions so = session_options(a.common, "run");
+  trace_into(set.get(), a.out, &so);
+  runtime::SessionResult r;
+  Json measured;
+#ifdef VMH_HAVE_SIM
+  measured = run_on_truth(&run_case, p, a.gain_scale, &dev, so, &r);
+#endif
+  if (measured.is_null()) {
+    measured = run_on_device(&dev, p.scene, p.sets, a.gain_scale, so, &r);
+  }
+  const Json summary = summary_json(p, measured, r);
+  if (set) commit_set(set.get(), &dev, r, p, a, summary);
+  std::cout << dump_readable(summary) << '\n';
+  runtime::raise_if_cut_short(r, "hw run");
+  // a signal after the session, while its claims were judged or its set
+  // went in
+  runtime::throw_if_stopped(
+      "hw run", "; after its session" +
+                    (set ? ": the set in " + a.out + " is whole" : std::string()));
+  throw_if_claims_failed(summary);
 }
 
 }  // namespace
