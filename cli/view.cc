@@ -100,31 +100,47 @@ std::unique_ptr<LiveDevice> open_live(const ViewOptions& o,
   return live;
 }
 
-void view(ViewOptions o) {
-  if (o.target.empty()) {
-    if (o.serve_hd.empty()) throw UsageError("view: give a case or a scene (target)");
-    o.target = "case1";
+// the options that need no scene: a target (case1 by default with
+// --serve-hd), --frames, the window's size
+void check_view_options(ViewOptions* o) {
+  if (o->target.empty()) {
+    if (o->serve_hd.empty()) throw UsageError("view: give a case or a scene (target)");
+    o->target = "case1";
   }
-  if (o.frames < 0) throw UsageError("--frames: must be >= 0");
-  if (o.width_px < 64 || o.height_px < 64) {
+  if (o->frames < 0) throw UsageError("--frames: must be >= 0");
+  if (o->width_px < 64 || o->height_px < 64) {
     throw UsageError("--width, --height: each must be at least 64 px");
   }
-  viz::ViewerOptions vo;
+}
+
+// the viewed case's name and scene file
+struct ViewedScene {
   std::string name;
   std::string scene;
+};
+
+ViewedScene resolve_viewed(const std::string& target) {
+  ViewedScene v;
   try {
-    scene = sim::resolve_scene(o.target, &name);
+    v.scene = sim::resolve_scene(target, &v.name);
   } catch (const sim::SimError& e) {
     throw UsageError(std::string("view: ") + e.what());
   }
-  // the thesis cases to step through with [ and ]; a scene file alone
+  return v;
+}
+
+// The viewer's options from the command line's: the cases to step through
+// with [ and ] (the thesis's, the viewed one first shown; a scene file
+// alone), the overrides, frames, screenshots and window size
+viz::ViewerOptions viewer_options(const ViewOptions& o, const ViewedScene& v) {
+  viz::ViewerOptions vo;
   for (const sim::CaseEntry& c : sim::case_catalogue()) {
     std::string n;
     vo.cases.push_back({c.name, sim::resolve_scene(c.name, &n)});
-    if (n == name) vo.case_index = static_cast<int>(vo.cases.size()) - 1;
+    if (n == v.name) vo.case_index = static_cast<int>(vo.cases.size()) - 1;
   }
-  if (vo.cases[static_cast<std::size_t>(vo.case_index)].name != name) {
-    vo.cases = {{name, scene}};
+  if (vo.cases[static_cast<std::size_t>(vo.case_index)].name != v.name) {
+    vo.cases = {{v.name, v.scene}};
     vo.case_index = 0;
   }
   std::error_code ec;
@@ -141,48 +157,45 @@ void view(ViewOptions o) {
   vo.screenshot_last_frame = o.screenshot;
   vo.width_px = o.width_px;
   vo.height_px = o.height_px;
-  // Ctrl-C and kill end the window's loop like its close button, so that
-  // a device is left at zero torque and a served name is removed
-  StopSignals signals;
-  vo.stop_requested = [&signals] { return signals.requested(); };
-  std::unique_ptr<LiveDevice> live;
-  std::unique_ptr<sim::ServedEmulator> served;
-  if (!o.serve_hd.empty()) {
-    if (!o.device.empty() || o.mouse) {
-      throw UsageError("--serve-hd: the served emulator is driven by a client "
-                       "program and held by the mouse; not with --device or "
-                       "--mouse");
-    }
-    sim::ServedEmulatorOptions so;
-    so.name = o.serve_hd;
-    so.scene = scene;
-    so.overrides = o.sets;
-    try {
-      served = std::make_unique<sim::ServedEmulator>(so);
-    } catch (const sim::SimError& e) {
-      throw UsageError(std::string("view: ") + e.what());
-    }
-    served->start();
-    vo.cases = {{name, scene}};
-    vo.case_index = 0;
-    vo.served = served.get();
-    std::fprintf(stderr,
-                 "vmhaptics view: serving the emulated Omni of %s as %s; run "
-                 "an OpenHaptics program on it with\n"
-                 "  VMH_HD_DEVICE=%s LD_LIBRARY_PATH=<build>/lib program\n"
-                 "(left-drag grabs the stylus, release lets go)\n",
-                 name.c_str(), served->spec().c_str(), served->spec().c_str());
-  } else if (!o.device.empty()) {
-    live = open_live(o, scene, &vo);
-  } else {
-    // bad --set values are usage errors even where no window can open
-    try {
-      (void)sim::load_case(scene, o.sets);
-    } catch (const sim::SimError& e) {
-      throw UsageError(std::string("view: ") + e.what());
-    }
-  }
+  return vo;
+}
 
+// --serve-hd: the emulator served as served:NAME and started, the one case
+// shown, and how to run a program on it said on stderr
+std::unique_ptr<sim::ServedEmulator> serve_emulator(const ViewOptions& o,
+                                                    const ViewedScene& v,
+                                                    viz::ViewerOptions* vo) {
+  if (!o.device.empty() || o.mouse) {
+    throw UsageError("--serve-hd: the served emulator is driven by a client "
+                     "program and held by the mouse; not with --device or "
+                     "--mouse");
+  }
+  sim::ServedEmulatorOptions so;
+  so.name = o.serve_hd;
+  so.scene = v.scene;
+  so.overrides = o.sets;
+  std::unique_ptr<sim::ServedEmulator> served;
+  try {
+    served = std::make_unique<sim::ServedEmulator>(so);
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("view: ") + e.what());
+  }
+  served->start();
+  vo->cases = {{v.name, v.scene}};
+  vo->case_index = 0;
+  vo->served = served.get();
+  std::fprintf(stderr,
+               "vmhaptics view: serving the emulated Omni of %s as %s; run "
+               "an OpenHaptics program on it with\n"
+               "  VMH_HD_DEVICE=%s LD_LIBRARY_PATH=<build>/lib program\n"
+               "(left-drag grabs the stylus, release lets go)\n",
+               v.name.c_str(), served->spec().c_str(), served->spec().c_str());
+  return served;
+}
+
+// the window until it closes (or its frames are done), then its frame
+// rate on stderr; no display is a failure, a bad scene bad input
+void run_viewer(const viz::ViewerOptions& vo) {
   std::unique_ptr<viz::Viewer> viewer;
   try {
     viewer = std::make_unique<viz::Viewer>(vo);
@@ -197,6 +210,31 @@ void view(ViewOptions o) {
                "%.2f\n",
                viewer->frames(), viewer->frames_per_s(),
                viewer->realtime_factor());
+}
+
+void view(ViewOptions o) {
+  check_view_options(&o);
+  const ViewedScene v = resolve_viewed(o.target);
+  viz::ViewerOptions vo = viewer_options(o, v);
+  // Ctrl-C and kill end the window's loop like its close button, so that
+  // a device is left at zero torque and a served name is removed
+  StopSignals signals;
+  vo.stop_requested = [&signals] { return signals.requested(); };
+  std::unique_ptr<LiveDevice> live;
+  std::unique_ptr<sim::ServedEmulator> served;
+  if (!o.serve_hd.empty()) {
+    served = serve_emulator(o, v, &vo);
+  } else if (!o.device.empty()) {
+    live = open_live(o, v.scene, &vo);
+  } else {
+    // bad --set values are usage errors even where no window can open
+    try {
+      (void)sim::load_case(v.scene, o.sets);
+    } catch (const sim::SimError& e) {
+      throw UsageError(std::string("view: ") + e.what());
+    }
+  }
+  run_viewer(vo);
 }
 
 }  // namespace
