@@ -166,22 +166,17 @@ Json result_json(const bringup::IdentifyResult& r, const std::vector<std::string
   return out;
 }
 
-void identify_verb(const IdentifyCliOptions& o) {
-  const auto start = std::chrono::steady_clock::now();
-  // SIGINT / SIGTERM only set a flag (device/stop_signal.h), polled
-  // between recordings, in the fit, and before anything is written
-  StopSignals signals;
-  const std::string nothing = "; nothing written";
-  bringup::IdentifyOptions io;
-  io.fit = split_names(o.fit);
-  // a real device's recording names no scene: the emulator's default one
-  io.default_scene = sim::models_dir() + "/cases/case1.xml";
+// each directory's recording, in the order given, with the note on its
+// analysis window on stderr; a missing directory or one that is not a
+// recording is a UsageError
+std::vector<bringup::Recording> recordings_to_fit(
+    const std::vector<std::string>& dirs) {
   std::vector<bringup::Recording> recs;
-  for (const std::string& d : o.dirs) {
+  for (const std::string& d : dirs) {
     if (!std::filesystem::is_directory(d)) {
       throw UsageError("identify: " + d + " is not a directory");
     }
-    runtime::throw_if_stopped("identify", nothing);
+    runtime::throw_if_stopped("identify", "; nothing written");
     try {
       recs.push_back(bringup::load_recording(d));
       if (const std::string note = bringup::window_note(recs.back()); !note.empty()) {
@@ -191,26 +186,44 @@ void identify_verb(const IdentifyCliOptions& o) {
       throw UsageError(std::string("identify: not a recording: ") + e.what());
     }
   }
-  // where the results go, checked before the fit and before anything is
-  // written: a bad --out must not leave a model behind
+  return recs;
+}
+
+// the device's serial and the calibrated model's path
+struct IdentifyTargets {
+  std::string serial;
+  std::string model;
+};
+
+// Where the results go, checked before the fit and before anything is
+// written: a bad --out must not leave a model behind.
+IdentifyTargets check_targets(const IdentifyCliOptions& o,
+                              const std::vector<bringup::Recording>& recs) {
   if (!o.serial.empty()) check_serial(o.serial, "--serial");
-  const std::string serial = o.serial.empty() ? serial_of(recs, o.dirs) : o.serial;
-  const std::string model = o.model_out.empty()
-                                ? sim::models_dir() + "/omni/calibrated/" + serial + ".xml"
-                                : o.model_out;
+  IdentifyTargets t;
+  t.serial = o.serial.empty() ? serial_of(recs, o.dirs) : o.serial;
+  t.model = o.model_out.empty()
+                ? sim::models_dir() + "/omni/calibrated/" + t.serial + ".xml"
+                : o.model_out;
   try {
     if (!o.out.empty()) output::check_writable_dir(o.out);
     const std::filesystem::path model_dir =
-        std::filesystem::path(model).parent_path();
+        std::filesystem::path(t.model).parent_path();
     if (!model_dir.empty()) output::check_writable_dir(model_dir.string());
-    output::check_replaceable(model);
+    output::check_replaceable(t.model);
   } catch (const std::runtime_error& e) {
     throw UsageError(std::string("identify: ") + e.what());
   }
+  return t;
+}
 
-  bringup::IdentifyResult r;
+// the fit; what it cannot fit on (no pulse, the recordings' scene) is bad
+// input
+bringup::IdentifyResult fit_recordings(
+    const std::vector<bringup::Recording>& recs,
+    const bringup::IdentifyOptions& io) {
   try {
-    r = bringup::identify(recs, io);
+    return bringup::identify(recs, io);
   } catch (const bringup::IdentifyError& e) {
     throw UsageError(e.what());
   } catch (const sim::SimError& e) {
@@ -218,7 +231,11 @@ void identify_verb(const IdentifyCliOptions& o) {
     // parameters: bad input, as a bad recording is
     throw UsageError(std::string("identify: the recordings' scene: ") + e.what());
   }
+}
 
+// the calibrated model's provenance comment: who, when, from what, the fit
+std::string provenance(const std::string& serial,
+                       const bringup::IdentifyResult& r) {
   std::ostringstream prov;
   prov << "calibrated by vmhaptics identify: serial " << serial << ", " << utc_now()
        << "; recordings";
@@ -229,17 +246,20 @@ void identify_verb(const IdentifyCliOptions& o) {
          << (p.identified ? "" : " (not identified)");
   }
   prov << "; edit " << sim::omni_edit_text(r.edit) << "; " << r.conditioning;
-  const std::string figure = o.out.empty() ? std::string() : fit_figure(r);
-  runtime::throw_if_stopped("identify", nothing);
-  const std::filesystem::path model_dir = std::filesystem::path(model).parent_path();
-  if (!model_dir.empty()) std::filesystem::create_directories(model_dir);
-  bringup::write_calibrated_model(r.edit, sim::models_dir() + "/omni/omni.xml", model, prov.str());
+  return prov.str();
+}
 
+// identify.json's object (also what is printed): the serial, the result,
+// the model and every output, and the run time since `start`
+Json identify_json(const IdentifyCliOptions& o, const IdentifyTargets& t,
+                   const bringup::IdentifyResult& r,
+                   const bringup::IdentifyOptions& io,
+                   std::chrono::steady_clock::time_point start) {
   Json out;
-  out["serial"] = serial;
+  out["serial"] = t.serial;
   out.update(result_json(r, io.fit));
-  out["model"] = model;
-  Json outputs = Json::array({model});
+  out["model"] = t.model;
+  Json outputs = Json::array({t.model});
   if (!o.out.empty()) {
     outputs.push_back(o.out + "/identify.json");
     outputs.push_back(o.out + "/identify_fit.svg");
@@ -247,19 +267,49 @@ void identify_verb(const IdentifyCliOptions& o) {
   out["outputs"] = outputs;
   out["run_time_s"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+// exit 1 when the fit did not converge or is poorly conditioned
+void throw_if_poor_fit(const bringup::IdentifyResult& r) {
+  if (!r.converged) {
+    throw std::runtime_error("identify: the fit did not converge in " +
+                             std::to_string(r.iterations) + " iterations");
+  }
+  if (r.poorly_conditioned) throw std::runtime_error("identify: " + r.conditioning);
+}
+
+void identify_verb(const IdentifyCliOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  // SIGINT / SIGTERM only set a flag (device/stop_signal.h), polled
+  // between recordings, in the fit, and before anything is written
+  StopSignals signals;
+  bringup::IdentifyOptions io;
+  io.fit = split_names(o.fit);
+  // a real device's recording names no scene: the emulator's default one
+  io.default_scene = sim::models_dir() + "/cases/case1.xml";
+  const std::vector<bringup::Recording> recs = recordings_to_fit(o.dirs);
+  const IdentifyTargets t = check_targets(o, recs);
+  const bringup::IdentifyResult r = fit_recordings(recs, io);
+
+  const std::string prov = provenance(t.serial, r);
+  const std::string figure = o.out.empty() ? std::string() : fit_figure(r);
+  runtime::throw_if_stopped("identify", "; nothing written");
+  const std::filesystem::path model_dir = std::filesystem::path(t.model).parent_path();
+  if (!model_dir.empty()) std::filesystem::create_directories(model_dir);
+  bringup::write_calibrated_model(r.edit, sim::models_dir() + "/omni/omni.xml",
+                                  t.model, prov);
+
+  const Json out = identify_json(o, t, r, io, start);
   if (!o.out.empty()) {
     output::write_file_in(o.out, "identify_fit.svg", figure);
     output::write_file_in(o.out, "identify.json", dump_readable(out) + "\n");
   }
   // a signal while the files went out: they are whole, and the exit says so
   runtime::throw_if_stopped("identify", "; its files were already written (" +
-                                            outputs.dump() + ")");
+                                            out["outputs"].dump() + ")");
   std::cout << dump_readable(out) << '\n';
-  if (!r.converged) {
-    throw std::runtime_error("identify: the fit did not converge in " +
-                             std::to_string(r.iterations) + " iterations");
-  }
-  if (r.poorly_conditioned) throw std::runtime_error("identify: " + r.conditioning);
+  throw_if_poor_fit(r);
 }
 
 }  // namespace
