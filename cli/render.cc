@@ -97,10 +97,8 @@ class RenderScratch {
   std::string path_;
 };
 
-void render_verb(const RenderOptions& o) {
-  // SIGINT / SIGTERM only set a flag (device/stop_signal.h), polled
-  // between frames (viz::render) and before the images are moved in
-  StopSignals signals;
+// the request from the options, checked before anything runs
+viz::RenderRequest render_request(const RenderOptions& o) {
   viz::RenderRequest req;
   req.times_s = parse_times(o.times);
   try {
@@ -128,41 +126,48 @@ void render_verb(const RenderOptions& o) {
   } catch (const viz::RenderInputError& e) {
     throw UsageError(e.what());
   }
+  return req;
+}
 
-  std::vector<viz::RenderedImage> images;
-  {
-    RenderScratch scratch(o.out);
-    req.out_dir = scratch.path();
-    try {
-      images = viz::render(req);
-    } catch (const viz::RenderInputError& e) {
-      throw UsageError(e.what());
-    } catch (const sim::SimError& e) {
-      throw UsageError(std::string("render ") + req.name + ": " + e.what());
-    } catch (const runtime::SignalStop&) {
-      runtime::throw_if_stopped("render", "; nothing written");
-      throw;
-    }
+// the images drawn into req's folder; bad input (a time past the scene's
+// end, a camera it lacks, a bad scene) is a UsageError, a signal a
+// SignalStop with nothing written
+std::vector<viz::RenderedImage> render_images(const viz::RenderRequest& req) {
+  try {
+    return viz::render(req);
+  } catch (const viz::RenderInputError& e) {
+    throw UsageError(e.what());
+  } catch (const sim::SimError& e) {
+    throw UsageError(std::string("render ") + req.name + ": " + e.what());
+  } catch (const runtime::SignalStop&) {
     runtime::throw_if_stopped("render", "; nothing written");
-    std::error_code ec;
-    fs::create_directories(o.out, ec);
-    if (ec) {
-      throw std::runtime_error("render: cannot create folder '" + o.out +
-                               "': " + ec.message());
-    }
-    for (viz::RenderedImage& img : images) {
-      const fs::path to = fs::path(o.out) / fs::path(img.path).filename();
-      fs::rename(img.path, to, ec);
-      if (ec) {
-        throw std::runtime_error("render: " + to.string() + ": " + ec.message());
-      }
-      img.path = to.string();
-    }
+    throw;
   }
-  // a signal while the images went in: they are all there, and the exit
-  // says so
-  runtime::throw_if_stopped("render", "; its images were already in " + o.out);
+}
 
+// each image renamed from the private folder into `out` (created if
+// needed), its path then the one in `out`
+void move_images(const std::string& out,
+                 std::vector<viz::RenderedImage>* images) {
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) {
+    throw std::runtime_error("render: cannot create folder '" + out +
+                             "': " + ec.message());
+  }
+  for (viz::RenderedImage& img : *images) {
+    const fs::path to = fs::path(out) / fs::path(img.path).filename();
+    fs::rename(img.path, to, ec);
+    if (ec) {
+      throw std::runtime_error("render: " + to.string() + ": " + ec.message());
+    }
+    img.path = to.string();
+  }
+}
+
+// the JSON printed: the request and each image (docs/outputs.md, "render")
+Json render_json(const viz::RenderRequest& req,
+                 const std::vector<viz::RenderedImage>& images) {
   Json j;
   j["scene"] = req.scene_path;
   j["case"] = req.name;
@@ -180,7 +185,26 @@ void render_verb(const RenderOptions& o) {
     im["d_path_mm"] = img.d_path_mm;
     j["images"].push_back(std::move(im));
   }
-  std::cout << dump_readable(j) << '\n';
+  return j;
+}
+
+void render_verb(const RenderOptions& o) {
+  // SIGINT / SIGTERM only set a flag (device/stop_signal.h), polled
+  // between frames (viz::render) and before the images are moved in
+  StopSignals signals;
+  viz::RenderRequest req = render_request(o);
+  std::vector<viz::RenderedImage> images;
+  {
+    RenderScratch scratch(o.out);
+    req.out_dir = scratch.path();
+    images = render_images(req);
+    runtime::throw_if_stopped("render", "; nothing written");
+    move_images(o.out, &images);
+  }
+  // a signal while the images went in: they are all there, and the exit
+  // says so
+  runtime::throw_if_stopped("render", "; its images were already in " + o.out);
+  std::cout << dump_readable(render_json(req, images)) << '\n';
 }
 
 }  // namespace
