@@ -68,17 +68,17 @@ void validate_render_request(const RenderRequest& req) {
   check_size("--height", req.height_px);
 }
 
-std::vector<RenderedImage> render(const RenderRequest& req) {
-  validate_render_request(req);
-  std::vector<double> times = req.times_s;
-  std::sort(times.begin(), times.end());
+namespace {
 
-  sim::ClosedLoop loop(req.scene_path, req.overrides, req.model_hook);
-  // past the script's end the hand only holds its last target: a later
-  // time shows nothing new, and a far one (1e6 s) would run for hours
+// Refuses (RenderInputError) a last time past the scene's duration_s or a
+// camera the model lacks, before any context is made. Past the script's
+// end the hand only holds its last target: a later time shows nothing
+// new, and a far one (1e6 s) would run for hours.
+void check_against_scene(const RenderRequest& req, const sim::ClosedLoop& loop,
+                         double last_t_s) {
   const double duration_s = loop.the_case().config().sim.duration_s;
-  if (times.back() > duration_s) {
-    throw RenderInputError("--t: time " + format("%g", times.back()) +
+  if (last_t_s > duration_s) {
+    throw RenderInputError("--t: time " + format("%g", last_t_s) +
                            " s is past the scene's duration_s, " +
                            format("%g", duration_s) + " s (" + req.name +
                            "'s script ends there)");
@@ -90,6 +90,76 @@ std::vector<RenderedImage> render(const RenderRequest& req) {
       throw RenderInputError(std::string("--camera: ") + e.what());
     }
   }
+}
+
+// Ticks the loop to the first tick end at or after t_s (at t = 0 one
+// tick, so that the controller's output, the overlay, exists), polling
+// the stop signals every 4096 ticks; `row` is the last tick's record.
+void tick_to(double t_s, sim::ClosedLoop* loop, TickRecord* row,
+             bool* ticked) {
+  for (long n = 1; !*ticked || loop->time_s() < t_s - 1e-9; ++n) {
+    loop->tick(row);
+    loop->throw_if_physics_fault();  // a picture of a reset state says nothing
+    *ticked = true;
+    if (n % 4096 == 0) runtime::throw_if_stopped("render");
+  }
+}
+
+// the label's two columns: the case, t, |F| and d_path, and their values
+RenderLabel label_of(const RenderRequest& req, const RenderedImage& img) {
+  RenderLabel label;
+  if (req.label) {
+    label.titles = req.name + "\nt\n|F|\nd_path";
+    label.values = "\n" + format("%.3f s", img.sim_t_s) + "\n" +
+                   format("%.2f N", img.force_N) + "\n" +
+                   format("%.2f mm", img.d_path_mm);
+  }
+  return label;
+}
+
+// The loop's state at the time asked for, t_s, drawn with its overlay and
+// label and written as a PNG into req.out_dir; `prims` is scratch for the
+// overlay.
+RenderedImage draw_image(const RenderRequest& req, double t_s,
+                         sim::ClosedLoop* loop, const TickRecord& row,
+                         SceneRenderer* renderer,
+                         std::vector<OverlayPrimitive>* prims) {
+  const auto start = std::chrono::steady_clock::now();
+  prims->clear();
+  if (req.overlays) {
+    overlay_primitives(loop->controller().mechanism(),
+                       loop->controller_params(), row.out, OverlayOptions(),
+                       prims);
+  }
+  RenderedImage img;
+  img.t_s = t_s;
+  img.sim_t_s = loop->time_s();
+  img.width_px = req.width_px;
+  img.height_px = req.height_px;
+  img.force_N = row.out.force_device_N.norm();
+  img.d_path_mm = row.d_path_mm;
+  const std::vector<std::uint8_t> rgb =
+      renderer->render_rgb(loop->model(), loop->data(), *prims, req.width_px,
+                           req.height_px, req.camera, label_of(req, img));
+  img.path = (std::filesystem::path(req.out_dir) /
+              render_file_name(req.name, t_s))
+                 .string();
+  write_png(img.path, req.width_px, req.height_px, rgb);
+  img.render_wall_s = std::chrono::duration<double>(
+                          std::chrono::steady_clock::now() - start)
+                          .count();
+  return img;
+}
+
+}  // namespace
+
+std::vector<RenderedImage> render(const RenderRequest& req) {
+  validate_render_request(req);
+  std::vector<double> times = req.times_s;
+  std::sort(times.begin(), times.end());
+
+  sim::ClosedLoop loop(req.scene_path, req.overrides, req.model_hook);
+  check_against_scene(req, loop, times.back());
   // the context first: without a display nothing is created
   GlContext gl;
   SceneRenderer renderer(loop.model(), loop.controller_params().omni,
@@ -100,53 +170,15 @@ std::vector<RenderedImage> render(const RenderRequest& req) {
     throw std::runtime_error("render: cannot create folder '" + req.out_dir +
                              "': " + ec.message());
   }
-  OverlayOptions opt;
   std::vector<OverlayPrimitive> prims;
   std::vector<RenderedImage> images;
   TickRecord row;
   bool ticked = false;
   for (double t : times) {
-    // the first tick end at or after t; at t = 0 one tick, so that the
-    // controller's output (the overlay) exists
     runtime::throw_if_stopped("render");
-    for (long n = 1; !ticked || loop.time_s() < t - 1e-9; ++n) {
-      loop.tick(&row);
-      loop.throw_if_physics_fault();  // a picture of a reset state says nothing
-      ticked = true;
-      if (n % 4096 == 0) runtime::throw_if_stopped("render");
-    }
+    tick_to(t, &loop, &row, &ticked);
     runtime::throw_if_stopped("render");
-    const auto start = std::chrono::steady_clock::now();
-    prims.clear();
-    if (req.overlays) {
-      overlay_primitives(loop.controller().mechanism(),
-                         loop.controller_params(), row.out, opt, &prims);
-    }
-    RenderedImage img;
-    img.t_s = t;
-    img.sim_t_s = loop.time_s();
-    img.width_px = req.width_px;
-    img.height_px = req.height_px;
-    img.force_N = row.out.force_device_N.norm();
-    img.d_path_mm = row.d_path_mm;
-    RenderLabel label;
-    if (req.label) {
-      label.titles = req.name + "\nt\n|F|\nd_path";
-      label.values = "\n" + format("%.3f s", img.sim_t_s) + "\n" +
-                     format("%.2f N", img.force_N) + "\n" +
-                     format("%.2f mm", img.d_path_mm);
-    }
-    const std::vector<std::uint8_t> rgb =
-        renderer.render_rgb(loop.model(), loop.data(), prims, req.width_px,
-                            req.height_px, req.camera, label);
-    img.path = (std::filesystem::path(req.out_dir) /
-                render_file_name(req.name, t))
-                   .string();
-    write_png(img.path, req.width_px, req.height_px, rgb);
-    img.render_wall_s = std::chrono::duration<double>(
-                            std::chrono::steady_clock::now() - start)
-                            .count();
-    images.push_back(img);
+    images.push_back(draw_image(req, t, &loop, row, &renderer, &prims));
   }
   return images;
 }
