@@ -1,5 +1,8 @@
-// The emulator's hand programs' names, and its transport faults from
-// their text form (sim/fault_vocabulary.h parses it).
+// The emulator's hand programs' names, and its transport faults
+// (sim/emulator_faults.h) from their text form (sim/fault_vocabulary.h
+// parses it).
+#include "sim/emulator_faults.h"
+
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>

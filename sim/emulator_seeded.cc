@@ -1,5 +1,5 @@
-// The emulator's seeded faults (sim/emulator.h, SeededFaults) from their
-// text form (sim/fault_vocabulary.h parses it), and their effect on the
+// The emulator's seeded faults (sim/emulator_faults.h, SeededFaults) from
+// their text form (sim/fault_vocabulary.h parses it), and their effect on the
 // reported joint angles.
 #include <cmath>
 #include <cstdlib>
@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "sim/emulator.h"
+#include "sim/emulator_faults.h"
 #include "sim/fault_vocabulary.h"
 
 namespace vmh::sim {
