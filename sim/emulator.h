@@ -305,7 +305,20 @@ class Emulator final : public HapticDevice {
   double time_tolerance_s() const noexcept;
   double apply_faults(double t_s) noexcept;
   Vec3 motor_command(double now_s) noexcept;
+  // the period's snapshot and truth: publish() measures (read_sensors),
+  // hands the servo thread the reading or a late one (publish_reading)
+  // and fills the truth (fill_truth)
   void publish(double now_s) noexcept;
+  // the sensors quantised, as raw values and decoded angles with the
+  // seeded faults, the inkwell switch (the true wrist centre and stylus
+  // axis into *truth) and the device's own kinematics
+  void read_sensors(const Joints& q_dh, DeviceState* state,
+                    EmulatorTruth* truth) noexcept;
+  // the reading into the late ring, and the one due now into state_
+  void publish_reading(const Published& p, double now_s) noexcept;
+  // the truth of the period just ended (all but `docked`, from the reading)
+  void fill_truth(const Joints& q_dh, double now_s,
+                  EmulatorTruth* truth) noexcept;
 
   EmulatorOptions options_;
   std::unique_ptr<ClosedLoop> loop_;

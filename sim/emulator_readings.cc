@@ -35,29 +35,38 @@ bool all_finite(const mjtNum* v, int n) {
 }  // namespace
 
 void Emulator::publish(double now_s) noexcept {
-  PhysicsState& ps = *ps_;
-  const mjModel* m = loop_->model();
-  mjData* d = loop_->data();
-  SimDevice& dev = loop_->device();
-  const Joints q_dh = dev.true_q_dh();
+  const Joints q_dh = loop_->device().true_q_dh();
 
   Published p;
   p.publish_wall_s = now_s;
   p.finite = q_dh.allFinite();
   DeviceState& s = p.state;
   EmulatorTruth t;
-  if (p.finite) {
-    const Joints q_meas = ps.sensor.measure(dh_to_device_joints(q_dh));
-    s.encoder_counts = hw::encoder_counts_from_angles(q_meas.head<3>(), factory_);
-    s.gimbal_pots = hw::pot_codes_from_angles(q_meas.tail<3>(), factory_);
-    s.q_device_rad = hw::angles_from_raw(s.encoder_counts, s.gimbal_pots, cal_.read());
-    apply_seeded_readings(options_.seeded, &s.q_device_rad);
-    s.docked = ps.hand.docked(q_dh, &t.p_end_mm, &t.stylus_axis);
-    ps.kinematics.fill(m, d, &s);
-  }
+  if (p.finite) read_sensors(q_dh, &s, &t);
   s.timestamp_s = now_s;
   s.present |= kStateJoints | kStateButtons | kStateInkwell | kStateTimestamp |
               kStateEncoders | kStatePots;
+  publish_reading(p, now_s);
+  fill_truth(q_dh, now_s, &t);
+  t.docked = s.docked;
+  truth_.write(t);
+}
+
+void Emulator::read_sensors(const Joints& q_dh, DeviceState* state,
+                            EmulatorTruth* truth) noexcept {
+  PhysicsState& ps = *ps_;
+  DeviceState& s = *state;
+  const Joints q_meas = ps.sensor.measure(dh_to_device_joints(q_dh));
+  s.encoder_counts = hw::encoder_counts_from_angles(q_meas.head<3>(), factory_);
+  s.gimbal_pots = hw::pot_codes_from_angles(q_meas.tail<3>(), factory_);
+  s.q_device_rad = hw::angles_from_raw(s.encoder_counts, s.gimbal_pots, cal_.read());
+  apply_seeded_readings(options_.seeded, &s.q_device_rad);
+  s.docked = ps.hand.docked(q_dh, &truth->p_end_mm, &truth->stylus_axis);
+  ps.kinematics.fill(loop_->model(), loop_->data(), &s);
+}
+
+void Emulator::publish_reading(const Published& p, double now_s) noexcept {
+  PhysicsState& ps = *ps_;
   ps.ring[static_cast<std::size_t>(ps.periods % (kMaxLatePeriods + 1))] = p;
   const long late = std::min<long>(ps.late_count + delay_periods_, kMaxLatePeriods);
   if (late > 0 && (ps.periods >= late || delay_periods_ > 0)) {
@@ -71,7 +80,14 @@ void Emulator::publish(double now_s) noexcept {
   } else {
     state_.write(p);
   }
+}
 
+void Emulator::fill_truth(const Joints& q_dh, double now_s,
+                          EmulatorTruth* truth) noexcept {
+  PhysicsState& ps = *ps_;
+  const mjModel* m = loop_->model();
+  mjData* d = loop_->data();
+  EmulatorTruth& t = *truth;
   t.t_sim_s = ps.t_sim_s;
   t.wall_s = now_s;
   t.periods = ps.periods;
@@ -91,14 +107,13 @@ void Emulator::publish(double now_s) noexcept {
   t.hand_target = ps.target;
   t.segment = ps.segment;
   t.program = ps.program;
-  t.motor_torque_Nm = dev.motor_torque_Nm();
+  t.motor_torque_Nm = loop_->device().motor_torque_Nm();
   t.energy_motor_J = ps.energy_motor_J;
   t.energy_hand_J = ps.energy_hand_J;
   mj_mulM(m, d, ps.mv.data(), d->qvel);
   t.kinetic_J = 0.5 * mju_dot(d->qvel, ps.mv.data(), m->nv);
   t.state_finite = all_finite(d->qpos, m->nq) && all_finite(d->qvel, m->nv) &&
                    all_finite(d->qacc, m->nv) && all_finite(d->ctrl, m->nu);
-  t.docked = s.docked;
   t.manual_held = ps.manual_held;
   t.device_watchdog_fired = ps.watchdog_fired;
   t.invalid_command = ps.invalid_command;
@@ -106,7 +121,6 @@ void Emulator::publish(double now_s) noexcept {
   t.stalled = ps.stalled;
   t.late = ps.late_count > 0;
   t.drops_pending = drops_.load(std::memory_order_relaxed);
-  truth_.write(t);
 }
 
 DeviceError Emulator::read_state(DeviceState* state) noexcept {
