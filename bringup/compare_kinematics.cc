@@ -122,6 +122,221 @@ std::vector<SuspectedFault> geometry_faults(const GeometryFit& f) {
   return out;
 }
 
+// compare_kinematics' four checks, in the order they are reported
+constexpr const char* kKinematicsChecks[] = {
+    "kinematics.position_error_p95", "kinematics.position_error_max",
+    "kinematics.stylus_axis_error_p95", "kinematics.rotation_error_p95"};
+
+// The good rows with a device transform, and at each the project's FK of
+// the recorded angles against it: the wrist centre's error (mm), the
+// model's stylus axis and the device's rotation (device frame)
+struct KinematicsSamples {
+  std::vector<std::size_t> rows;
+  std::vector<double> t_s, pos_err_mm;
+  std::vector<Vec3> axis_model;
+  std::vector<Mat3> R_dev;
+};
+
+KinematicsSamples kinematics_samples(const Recording& rec) {
+  const OmniParams params;
+  KinematicsSamples k;
+  for (std::size_t r : rec.good_rows()) {
+    const Vec3 p_dev = rec.dev_p_mm(r);
+    const Mat3 R = rec.dev_R(r);
+    if (!p_dev.allFinite() || !R.allFinite()) continue;
+    const OmniPose pose = omni_fk(params, rec.q_dh_rad(r));
+    k.rows.push_back(r);
+    k.t_s.push_back(rec.t_s(r));
+    k.pos_err_mm.push_back(
+        (base_to_device_mm(params, pose.p_base_m) - p_dev).norm());
+    k.axis_model.push_back(base_to_device_vector(pose.R_base.col(2)));
+    k.R_dev.push_back(R);
+  }
+  return k;
+}
+
+// the angle (deg) between the model's stylus axis and the device
+// rotation's column col times sign, at each sample
+std::vector<double> axis_errors(const KinematicsSamples& k, int col,
+                                double sign) {
+  std::vector<double> e;
+  for (std::size_t i = 0; i < k.rows.size(); ++i) {
+    const double c =
+        std::clamp(k.axis_model[i].dot(sign * k.R_dev[i].col(col).normalized()),
+                   -1.0, 1.0);
+    e.push_back(std::acos(c) * kRadToDeg);
+  }
+  return e;
+}
+
+// The device's column (and sign) that is the stylus axis: the best median
+struct StylusColumn {
+  int col = 2;
+  double sign = 1.0;
+};
+
+StylusColumn stylus_column(const KinematicsSamples& k) {
+  StylusColumn best;
+  double best_median = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < 3; ++c) {
+    for (double s : {1.0, -1.0}) {
+      std::vector<double> e = axis_errors(k, c, s);
+      std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
+      if (e[e.size() / 2] < best_median) {
+        best_median = e[e.size() / 2];
+        best.col = c;
+        best.sign = s;
+      }
+    }
+  }
+  return best;
+}
+
+// The four checks: the wrist centre's p95 and worst error, the stylus
+// axis's p95 against the device rotation's column col_text, and the whole
+// stylus frame's p95 (the axis alone does not see t6), through the
+// device's rotation convention fitted at the nominal geometry
+void add_kinematics_checks(const ErrorStats& pos, const ErrorStats& axis,
+                           const std::string& col_text,
+                           const GeometryFit& nominal_fit,
+                           const std::string& dir, CompareSection* sec) {
+  sec->checks.push_back(
+      make_check(kKinematicsChecks[0], pos.p95, kPositionErrorP95ThresholdMm,
+                 "mm", CompareCheck::kAtMost,
+                 "project FK vs the device's wrist centre, p95 over " +
+                     std::to_string(pos.count) + " samples"));
+  sec->checks.push_back(
+      make_check(kKinematicsChecks[1], pos.max, kPositionErrorMaxThresholdMm,
+                 "mm", CompareCheck::kAtMost,
+                 "project FK vs the device's wrist centre, worst sample"));
+  sec->checks.push_back(
+      make_check(kKinematicsChecks[2], axis.p95,
+                 kStylusAxisErrorP95ThresholdDeg, "deg", CompareCheck::kAtMost,
+                 "project stylus axis vs the device rotation's " + col_text));
+  sec->checks.push_back(
+      make_check(kKinematicsChecks[3], nominal_fit.rotation_before_deg.p95,
+                 kStylusAxisErrorP95ThresholdDeg, "deg", CompareCheck::kAtMost,
+                 "project stylus frame (times the device's fixed convention) "
+                 "vs the device rotation, "
+                 "p95 over " +
+                     std::to_string(nominal_fit.samples_used) + " samples"));
+  for (CompareCheck& c : sec->checks) c.recording = dir;
+}
+
+// the five samples with the largest position error, worst first
+nlohmann::ordered_json worst_samples(const Recording& rec,
+                                     const KinematicsSamples& k,
+                                     const std::vector<double>& axis_err_deg) {
+  const std::vector<double>& pos_err_mm = k.pos_err_mm;
+  std::vector<std::size_t> order(k.rows.size());
+  std::iota(order.begin(), order.end(), 0);
+  const std::size_t n_worst = std::min<std::size_t>(5, order.size());
+  std::partial_sort(order.begin(), order.begin() + n_worst, order.end(),
+                    [&](std::size_t a, std::size_t b) {
+                      return pos_err_mm[a] > pos_err_mm[b];
+                    });
+  nlohmann::ordered_json worst = nlohmann::ordered_json::array();
+  for (std::size_t j = 0; j < n_worst; ++j) {
+    const std::size_t i = order[j];
+    const Joints q = rec.q_dh_rad(k.rows[i]);
+    worst.push_back({{"t_s", k.t_s[i]},
+                     {"q_dh_rad", std::vector<double>(q.data(), q.data() + 6)},
+                     {"position_error_mm", pos_err_mm[i]},
+                     {"stylus_axis_error_deg", axis_err_deg[i]}});
+  }
+  return worst;
+}
+
+// the reading map chosen, with its evidence and every hypothesis's figures
+nlohmann::ordered_json readings_json(const ReadingDiagnosis& diag) {
+  nlohmann::ordered_json hyps = nlohmann::ordered_json::array();
+  for (const ReadingHypothesis& h : diag.hypotheses) {
+    hyps.push_back(
+        {{"map", h.map.is_identity() ? "identity" : h.map.name},
+         {"perm", h.map.perm},
+         {"sign", h.map.sign},
+         {"position_p95_after_fit_mm", h.fit.position_after_mm.p95},
+         {"rotation_p95_after_fit_deg", h.fit.rotation_after_deg.p95},
+         {"normalized_p95", h.normalized_p95},
+         {"iterations", h.fit.iterations},
+         {"explains", h.fit.explains}});
+  }
+  return {{"map", diag.map.is_identity() ? "identity" : diag.map.name},
+          {"perm", diag.map.perm},
+          {"sign", diag.map.sign},
+          {"evidence", diag.evidence},
+          {"hypotheses", hyps}};
+}
+
+// What a failed check points to: the reading map found, else the
+// geometry the fit singles out when it explains the transform, else
+// kinematics_unexplained with the figures
+void name_kinematics_faults(const ReadingDiagnosis& diag,
+                            const GeometryFit& fit, const ErrorStats& pos,
+                            const ErrorStats& axis, const std::string& dir,
+                            CompareSection* sec) {
+  if (!diag.map.is_identity()) {
+    sec->faults.push_back({diag.map.name, diag.evidence, {}});
+  } else if (fit.explains) {
+    sec->faults = geometry_faults(fit);
+  }
+  if (sec->faults.empty()) {
+    sec->faults.push_back(
+        {"kinematics_unexplained",
+         kin_fmt("position p95 %.2f mm, stylus axis p95 %.2f deg; after the "
+                 "geometry fit "
+                 "%.2f mm",
+                 pos.p95, axis.p95, fit.position_after_mm.p95) +
+             kin_fmt(", %.2f deg: no reading map or geometry explains it",
+                     fit.rotation_after_deg.p95),
+         {}});
+  }
+  for (SuspectedFault& f : sec->faults) f.recording = dir;
+}
+
+// kinematics_error.svg: the wrist centre's and the stylus axis's error
+// over time, each with its p95 threshold
+void write_kinematics_figure(const Recording& rec, const std::string& col_text,
+                             const std::vector<double>& t_s,
+                             const std::vector<double>& pos_err_mm,
+                             const std::vector<double>& axis_err_deg,
+                             const std::string& figure_dir,
+                             CompareSection* sec) {
+  output::ChartGrid g;
+  g.title = "Project FK vs the device's transform";
+  g.notes = {"recording " + rec.dir,
+             "device frame; stylus axis vs the device's " + col_text};
+  output::Chart a;
+  a.x.label = "time (s)";
+  a.y.label = "wrist position error (mm)";
+  a.series.push_back(
+      {"|p_FK - dev_p|", t_s, pos_err_mm, "", true, false, false});
+  a.series.push_back(
+      {"p95 threshold",
+       {t_s.front(), t_s.back()},
+       {kPositionErrorP95ThresholdMm, kPositionErrorP95ThresholdMm},
+       "#999999",
+       true,
+       false,
+       true});
+  output::Chart b;
+  b.x.label = "time (s)";
+  b.y.label = "stylus axis error (deg)";
+  b.series.push_back(
+      {"angle(z_FK, dev axis)", t_s, axis_err_deg, "", true, false, false});
+  b.series.push_back(
+      {"p95 threshold",
+       {t_s.front(), t_s.back()},
+       {kStylusAxisErrorP95ThresholdDeg, kStylusAxisErrorP95ThresholdDeg},
+       "#999999",
+       true,
+       false,
+       true});
+  g.panels = {a, b};
+  sec->figures.push_back(output::write_file_in(
+      figure_dir, "kinematics_error.svg", output::chart_grid_svg(g)));
+}
+
 }  // namespace
 
 std::vector<ReadingMap> reading_hypotheses() {
@@ -200,178 +415,61 @@ ReadingDiagnosis diagnose_readings(const Recording& rec) {
   return d;
 }
 
-CompareSection compare_kinematics(const Recording& rec, const std::string& figure_dir) {
+CompareSection compare_kinematics(const Recording& rec,
+                                  const std::string& figure_dir) {
   CompareSection sec;
   sec.name = "kinematics";
-  const char* kChecks[] = {"kinematics.position_error_p95", "kinematics.position_error_max",
-                           "kinematics.stylus_axis_error_p95", "kinematics.rotation_error_p95"};
   if (!rec.has_transform()) {
-    for (const char* c : kChecks) {
-      sec.skipped.push_back({c, "the recording has no device transform (dev_p_*_mm, dev_R_rc)",
-                             rec.dir});
+    for (const char* c : kKinematicsChecks) {
+      sec.skipped.push_back(
+          {c, "the recording has no device transform (dev_p_*_mm, dev_R_rc)",
+           rec.dir});
     }
     return sec;
   }
-  const OmniParams params;
-  std::vector<std::size_t> rows;
-  std::vector<double> t_s, pos_err_mm;
-  std::vector<Vec3> axis_model;
-  std::vector<Mat3> R_dev;
-  for (std::size_t r : rec.good_rows()) {
-    const Vec3 p_dev = rec.dev_p_mm(r);
-    const Mat3 R = rec.dev_R(r);
-    if (!p_dev.allFinite() || !R.allFinite()) continue;
-    const OmniPose pose = omni_fk(params, rec.q_dh_rad(r));
-    rows.push_back(r);
-    t_s.push_back(rec.t_s(r));
-    pos_err_mm.push_back((base_to_device_mm(params, pose.p_base_m) - p_dev).norm());
-    axis_model.push_back(base_to_device_vector(pose.R_base.col(2)));
-    R_dev.push_back(R);
-  }
-  if (rows.size() < 20) {
-    for (const char* c : kChecks) {
-      sec.skipped.push_back({c, std::to_string(rows.size()) +
-                                    " good rows with a device transform, at least 20 needed",
-                             rec.dir});
+  const KinematicsSamples k = kinematics_samples(rec);
+  if (k.rows.size() < 20) {
+    for (const char* c : kKinematicsChecks) {
+      sec.skipped.push_back(
+          {c,
+           std::to_string(k.rows.size()) +
+               " good rows with a device transform, at least 20 needed",
+           rec.dir});
     }
     return sec;
   }
-  // the device's column (and sign) that is the stylus axis: the best median
-  auto axis_errors = [&](int col, double sign) {
-    std::vector<double> e;
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      const double c = std::clamp(axis_model[i].dot(sign * R_dev[i].col(col).normalized()),
-                                  -1.0, 1.0);
-      e.push_back(std::acos(c) * kRadToDeg);
-    }
-    return e;
-  };
-  int best_col = 2;
-  double best_sign = 1.0, best_median = std::numeric_limits<double>::infinity();
-  for (int c = 0; c < 3; ++c) {
-    for (double s : {1.0, -1.0}) {
-      std::vector<double> e = axis_errors(c, s);
-      std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
-      if (e[e.size() / 2] < best_median) {
-        best_median = e[e.size() / 2];
-        best_col = c;
-        best_sign = s;
-      }
-    }
-  }
-  const std::vector<double> axis_err_deg = axis_errors(best_col, best_sign);
-  const ErrorStats pos = error_stats(pos_err_mm);
+  const StylusColumn column = stylus_column(k);
+  const std::vector<double> axis_err_deg =
+      axis_errors(k, column.col, column.sign);
+  const ErrorStats pos = error_stats(k.pos_err_mm);
   const ErrorStats axis = error_stats(axis_err_deg);
-
-  sec.checks.push_back(make_check(kChecks[0], pos.p95, kPositionErrorP95ThresholdMm, "mm",
-                                  CompareCheck::kAtMost,
-                                  "project FK vs the device's wrist centre, p95 over " +
-                                      std::to_string(pos.count) + " samples"));
-  sec.checks.push_back(make_check(kChecks[1], pos.max, kPositionErrorMaxThresholdMm, "mm",
-                                  CompareCheck::kAtMost,
-                                  "project FK vs the device's wrist centre, worst sample"));
-  const std::string col_text = std::string(best_sign > 0 ? "+" : "-") + "column " +
-                               std::to_string(best_col + 1);
-  sec.checks.push_back(make_check(kChecks[2], axis.p95, kStylusAxisErrorP95ThresholdDeg,
-                                  "deg", CompareCheck::kAtMost,
-                                  "project stylus axis vs the device rotation's " + col_text));
-  // the whole stylus frame (the axis alone does not see t6), through the
-  // device's rotation convention fitted at the nominal geometry
+  const std::string col_text = std::string(column.sign > 0 ? "+" : "-") +
+                               "column " + std::to_string(column.col + 1);
   const ReadingDiagnosis diag = diagnose_readings(rec);
-  const GeometryFit& nominal_fit = diag.hypotheses.front().fit;
-  sec.checks.push_back(make_check(
-      kChecks[3], nominal_fit.rotation_before_deg.p95, kStylusAxisErrorP95ThresholdDeg, "deg",
-      CompareCheck::kAtMost,
-      "project stylus frame (times the device's fixed convention) vs the device rotation, "
-      "p95 over " + std::to_string(nominal_fit.samples_used) + " samples"));
-  for (CompareCheck& c : sec.checks) c.recording = rec.dir;
-
-  std::vector<std::size_t> order(rows.size());
-  std::iota(order.begin(), order.end(), 0);
-  const std::size_t n_worst = std::min<std::size_t>(5, order.size());
-  std::partial_sort(order.begin(), order.begin() + n_worst, order.end(),
-                    [&](std::size_t a, std::size_t b) { return pos_err_mm[a] > pos_err_mm[b]; });
-  nlohmann::ordered_json worst = nlohmann::ordered_json::array();
-  for (std::size_t k = 0; k < n_worst; ++k) {
-    const std::size_t i = order[k];
-    const Joints q = rec.q_dh_rad(rows[i]);
-    worst.push_back({{"t_s", t_s[i]},
-                     {"q_dh_rad", std::vector<double>(q.data(), q.data() + 6)},
-                     {"position_error_mm", pos_err_mm[i]},
-                     {"stylus_axis_error_deg", axis_err_deg[i]}});
-  }
+  add_kinematics_checks(pos, axis, col_text, diag.hypotheses.front().fit,
+                        rec.dir, &sec);
 
   const std::size_t fit_samples = GeometryFitOptions{}.max_samples;
-  const GeometryFit fit =
-      fit_geometry(pose_samples(rec, diag.map, fit_samples), fit_options(fit_samples));
-  sec.detail["samples"] = rows.size();
+  const GeometryFit fit = fit_geometry(pose_samples(rec, diag.map, fit_samples),
+                                       fit_options(fit_samples));
+  sec.detail["samples"] = k.rows.size();
   sec.detail["position_error_mm"] = stats_json(pos);
   sec.detail["stylus_axis_error_deg"] = stats_json(axis);
-  sec.detail["worst_samples"] = worst;
-  sec.detail["rotation_column"] = {{"column", best_col + 1}, {"sign", best_sign},
-                                   {"text", col_text}};
-  nlohmann::ordered_json hyps = nlohmann::ordered_json::array();
-  for (const ReadingHypothesis& h : diag.hypotheses) {
-    hyps.push_back({{"map", h.map.is_identity() ? "identity" : h.map.name},
-                    {"perm", h.map.perm},
-                    {"sign", h.map.sign},
-                    {"position_p95_after_fit_mm", h.fit.position_after_mm.p95},
-                    {"rotation_p95_after_fit_deg", h.fit.rotation_after_deg.p95},
-                    {"normalized_p95", h.normalized_p95},
-                    {"iterations", h.fit.iterations},
-                    {"explains", h.fit.explains}});
-  }
-  sec.detail["readings"] = {{"map", diag.map.is_identity() ? "identity" : diag.map.name},
-                            {"perm", diag.map.perm},
-                            {"sign", diag.map.sign},
-                            {"evidence", diag.evidence},
-                            {"hypotheses", hyps}};
+  sec.detail["worst_samples"] = worst_samples(rec, k, axis_err_deg);
+  sec.detail["rotation_column"] = {
+      {"column", column.col + 1}, {"sign", column.sign}, {"text", col_text}};
+  sec.detail["readings"] = readings_json(diag);
   sec.detail["geometry_fit"] = fit_json(fit);
   sec.detail["geometry_fit"]["readings_map"] =
       diag.map.is_identity() ? "identity" : diag.map.name;
 
-  const bool failed = std::any_of(sec.checks.begin(), sec.checks.end(),
-                                  [](const CompareCheck& c) { return !c.pass; });
-  if (failed) {
-    if (!diag.map.is_identity()) {
-      sec.faults.push_back({diag.map.name, diag.evidence, {}});
-    } else if (fit.explains) {
-      sec.faults = geometry_faults(fit);
-    }
-    if (sec.faults.empty()) {
-      sec.faults.push_back(
-          {"kinematics_unexplained",
-           kin_fmt("position p95 %.2f mm, stylus axis p95 %.2f deg; after the geometry fit "
-               "%.2f mm",
-               pos.p95, axis.p95, fit.position_after_mm.p95) +
-               kin_fmt(", %.2f deg: no reading map or geometry explains it",
-                   fit.rotation_after_deg.p95),
-           {}});
-    }
-    for (SuspectedFault& f : sec.faults) f.recording = rec.dir;
-  }
-
+  const bool failed =
+      std::any_of(sec.checks.begin(), sec.checks.end(),
+                  [](const CompareCheck& c) { return !c.pass; });
+  if (failed) name_kinematics_faults(diag, fit, pos, axis, rec.dir, &sec);
   if (!figure_dir.empty()) {
-    output::ChartGrid g;
-    g.title = "Project FK vs the device's transform";
-    g.notes = {"recording " + rec.dir, "device frame; stylus axis vs the device's " + col_text};
-    output::Chart a;
-    a.x.label = "time (s)";
-    a.y.label = "wrist position error (mm)";
-    a.series.push_back({"|p_FK - dev_p|", t_s, pos_err_mm, "", true, false, false});
-    a.series.push_back({"p95 threshold", {t_s.front(), t_s.back()},
-                        {kPositionErrorP95ThresholdMm, kPositionErrorP95ThresholdMm},
-                        "#999999", true, false, true});
-    output::Chart b;
-    b.x.label = "time (s)";
-    b.y.label = "stylus axis error (deg)";
-    b.series.push_back({"angle(z_FK, dev axis)", t_s, axis_err_deg, "", true, false, false});
-    b.series.push_back({"p95 threshold", {t_s.front(), t_s.back()},
-                        {kStylusAxisErrorP95ThresholdDeg, kStylusAxisErrorP95ThresholdDeg},
-                        "#999999", true, false, true});
-    g.panels = {a, b};
-    sec.figures.push_back(
-        output::write_file_in(figure_dir, "kinematics_error.svg", output::chart_grid_svg(g)));
+    write_kinematics_figure(rec, col_text, k.t_s, k.pos_err_mm, axis_err_deg,
+                            figure_dir, &sec);
   }
   return sec;
 }
