@@ -182,8 +182,13 @@ ErrorStats error_stats(std::vector<double> v) {
   return e;
 }
 
-GeometryFit fit_geometry(const std::vector<PoseSample>& all,
-                         const GeometryFitOptions& o) {
+namespace {
+
+using MatP = Eigen::Matrix<double, kGeometryParams, kGeometryParams>;
+
+// Throws std::invalid_argument with fewer than 20 samples or one that is
+// not finite (its index named)
+void check_pose_samples(const std::vector<PoseSample>& all) {
   if (all.size() < 20) {
     throw std::invalid_argument("fit_geometry: " + std::to_string(all.size()) +
                                 " samples, at least 20 needed");
@@ -196,105 +201,156 @@ GeometryFit fit_geometry(const std::vector<PoseSample>& all,
                                   " is not finite");
     }
   }
+}
+
+// at most max(max_samples, 20) of the samples, evenly spread
+std::vector<PoseSample> spread_samples(const std::vector<PoseSample>& all,
+                                       std::size_t max_samples) {
   std::vector<PoseSample> s;
-  const std::size_t n = std::min(all.size(), std::max<std::size_t>(o.max_samples, 20));
+  const std::size_t n =
+      std::min(all.size(), std::max<std::size_t>(max_samples, 20));
   for (std::size_t i = 0; i < n; ++i) s.push_back(all[i * all.size() / n]);
+  return s;
+}
 
-  GeometryFit fit;
-  fit.samples_used = s.size();
-  const GeometryVec x0 = nominal_geometry();
-  GeometryVec x = x0;
-  Mat3 C = estimate_convention(x, s);
-  fit.convention_snapped = snap_to_signed_permutation(&C);
-  const Errors before = sample_errors(x, C, s);
-  fit.position_before_mm = error_stats(before.position_mm);
-  fit.rotation_before_deg = error_stats(before.rotation_deg);
+// What the fit's Levenberg-Marquardt works on: the samples, the device's
+// rotation convention C, the rotation weight w (mm/rad), which parameters
+// are free, and the normal equations J^T J, J^T r as last built
+struct GeometryProblem {
+  GeometryProblem(const std::vector<PoseSample>& samples,
+                  const Mat3& convention, double weight)
+      : s(samples), C(convention), w(weight) {}
 
-  std::array<bool, kGeometryParams> free;
-  free.fill(true);
-  const double w = o.rotation_weight_mm_per_rad;
-  using MatP = Eigen::Matrix<double, kGeometryParams, kGeometryParams>;
+  const std::vector<PoseSample>& s;
+  Mat3 C;
+  double w;
+  std::array<bool, kGeometryParams> free{};
   MatP JtJ;
   GeometryVec Jtr;
-  auto normal_equations = [&](const GeometryVec& at) {
-    JtJ.setZero();
-    Jtr.setZero();
-    double cost = 0;
-    for (const PoseSample& p : s) {
-      const GeometryJacobian J = geometry_residual_jacobian(at, p, C, w);
-      const GeometryResidual r = geometry_residual(at, p, C, w);
-      JtJ.noalias() += J.transpose() * J;
-      Jtr.noalias() += J.transpose() * r;
-      cost += r.squaredNorm();
-    }
-    for (int k = 0; k < kGeometryParams; ++k) {
-      if (free[k]) continue;
-      JtJ.row(k).setZero();
-      JtJ.col(k).setZero();
-      JtJ(k, k) = 1.0;
-      Jtr[k] = 0.0;
-    }
-    return cost;
-  };
-  auto cost_at = [&](const GeometryVec& at) {
-    double c = 0;
-    for (const PoseSample& p : s) c += geometry_residual(at, p, C, w).squaredNorm();
-    return c;
-  };
+};
 
-  // two rounds: the convention C re-estimated once the geometry has moved
-  for (int round = 0; round < 2; ++round) {
-    if (round > 0) {
-      C = estimate_convention(x, s);
-      fit.convention_snapped = snap_to_signed_permutation(&C);
-    }
-    free[kOffsetT1 + 5] = fit.convention_snapped;
-    if (!free[kOffsetT1 + 5]) x[kOffsetT1 + 5] = 0.0;
-    double lambda = 1e-3;
-    double cost = normal_equations(x);
-    for (int it = 0; it < o.max_iterations; ++it) {
-      ++fit.iterations;
-      MatP A = JtJ;
-      A.diagonal() += lambda * JtJ.diagonal().cwiseMax(1e-12);
-      const GeometryVec dx = A.ldlt().solve(-Jtr);
-      const GeometryVec xn = x + dx;
-      const double cn = cost_at(xn);
-      if (std::isfinite(cn) && cn < cost) {
-        const double gain = (cost - cn) / std::max(cost, 1e-300);
-        x = xn;
-        lambda = std::max(lambda / 3.0, 1e-9);
-        cost = normal_equations(x);
-        if (gain < 1e-10) break;
-      } else {
-        lambda *= 4.0;
-        if (lambda > 1e8) break;
-      }
+// Builds pb's normal equations at `at` (a fixed parameter's row and column
+// those of the identity, its gradient zero); returns the cost there
+double normal_equations(const GeometryVec& at, GeometryProblem* pb) {
+  MatP& JtJ = pb->JtJ;
+  GeometryVec& Jtr = pb->Jtr;
+  JtJ.setZero();
+  Jtr.setZero();
+  double cost = 0;
+  for (const PoseSample& p : pb->s) {
+    const GeometryJacobian J = geometry_residual_jacobian(at, p, pb->C, pb->w);
+    const GeometryResidual r = geometry_residual(at, p, pb->C, pb->w);
+    JtJ.noalias() += J.transpose() * J;
+    Jtr.noalias() += J.transpose() * r;
+    cost += r.squaredNorm();
+  }
+  for (int k = 0; k < kGeometryParams; ++k) {
+    if (pb->free[k]) continue;
+    JtJ.row(k).setZero();
+    JtJ.col(k).setZero();
+    JtJ(k, k) = 1.0;
+    Jtr[k] = 0.0;
+  }
+  return cost;
+}
+
+// the sum of squared residuals at `at`
+double cost_at(const GeometryProblem& pb, const GeometryVec& at) {
+  double c = 0;
+  for (const PoseSample& p : pb.s)
+    c += geometry_residual(at, p, pb.C, pb.w).squaredNorm();
+  return c;
+}
+
+// One round of Levenberg-Marquardt (Marquardt's scaling) from *x, at most
+// max_iterations steps, each counted in *iterations; it ends when a step
+// gains less than 1e-10 of the cost or lambda passes 1e8
+void geometry_lm_round(int max_iterations, GeometryProblem* pb, GeometryVec* x,
+                       int* iterations) {
+  double lambda = 1e-3;
+  double cost = normal_equations(*x, pb);
+  for (int it = 0; it < max_iterations; ++it) {
+    ++*iterations;
+    MatP A = pb->JtJ;
+    A.diagonal() += lambda * pb->JtJ.diagonal().cwiseMax(1e-12);
+    const GeometryVec dx = A.ldlt().solve(-pb->Jtr);
+    const GeometryVec xn = *x + dx;
+    const double cn = cost_at(*pb, xn);
+    if (std::isfinite(cn) && cn < cost) {
+      const double gain = (cost - cn) / std::max(cost, 1e-300);
+      *x = xn;
+      lambda = std::max(lambda / 3.0, 1e-9);
+      cost = normal_equations(*x, pb);
+      if (gain < 1e-10) break;
+    } else {
+      lambda *= 4.0;
+      if (lambda > 1e8) break;
     }
   }
-  normal_equations(x);
+}
 
-  fit.x = x;
-  fit.convention = C;
-  const Errors after = sample_errors(x, C, s);
-  fit.position_after_mm = error_stats(after.position_mm);
-  fit.rotation_after_deg = error_stats(after.rotation_deg);
-
-  // sigma^2 (J^T J)^-1 over the free parameters
-  const double dof = 12.0 * static_cast<double>(s.size()) - kGeometryParams;
-  const double sigma2 = cost_at(x) / dof;
-  Eigen::FullPivLU<MatP> lu(JtJ);
+// Each parameter with its nominal (x0) and fitted (x) value, and its sigma
+// from sigma^2 (J^T J)^-1 over the free parameters (pb's normal equations
+// built at x)
+std::vector<FittedParam> fitted_params(const GeometryProblem& pb,
+                                       const GeometryVec& x0,
+                                       const GeometryVec& x) {
+  const double dof = 12.0 * static_cast<double>(pb.s.size()) - kGeometryParams;
+  const double sigma2 = cost_at(pb, x) / dof;
+  Eigen::FullPivLU<MatP> lu(pb.JtJ);
   const MatP cov = lu.isInvertible() ? MatP(sigma2 * lu.inverse())
                                      : MatP::Constant(std::nan(""));
+  std::vector<FittedParam> out;
   for (int k = 0; k < kGeometryParams; ++k) {
     FittedParam p;
     p.name = geometry_param_name(k);
     p.unit = geometry_param_unit(k);
     p.nominal = x0[k];
     p.fitted = x[k];
-    p.free = free[k];
-    p.sigma = free[k] ? std::sqrt(std::max(cov(k, k), 0.0)) : 0.0;
-    fit.params.push_back(p);
+    p.free = pb.free[k];
+    p.sigma = pb.free[k] ? std::sqrt(std::max(cov(k, k), 0.0)) : 0.0;
+    out.push_back(p);
   }
+  return out;
+}
+
+}  // namespace
+
+GeometryFit fit_geometry(const std::vector<PoseSample>& all,
+                         const GeometryFitOptions& o) {
+  check_pose_samples(all);
+  const std::vector<PoseSample> s = spread_samples(all, o.max_samples);
+
+  GeometryFit fit;
+  fit.samples_used = s.size();
+  const GeometryVec x0 = nominal_geometry();
+  GeometryVec x = x0;
+  GeometryProblem pb(s, estimate_convention(x, s),
+                     o.rotation_weight_mm_per_rad);
+  fit.convention_snapped = snap_to_signed_permutation(&pb.C);
+  const Errors before = sample_errors(x, pb.C, s);
+  fit.position_before_mm = error_stats(before.position_mm);
+  fit.rotation_before_deg = error_stats(before.rotation_deg);
+
+  pb.free.fill(true);
+  // two rounds: the convention C re-estimated once the geometry has moved
+  for (int round = 0; round < 2; ++round) {
+    if (round > 0) {
+      pb.C = estimate_convention(x, s);
+      fit.convention_snapped = snap_to_signed_permutation(&pb.C);
+    }
+    pb.free[kOffsetT1 + 5] = fit.convention_snapped;
+    if (!pb.free[kOffsetT1 + 5]) x[kOffsetT1 + 5] = 0.0;
+    geometry_lm_round(o.max_iterations, &pb, &x, &fit.iterations);
+  }
+  normal_equations(x, &pb);
+
+  fit.x = x;
+  fit.convention = pb.C;
+  const Errors after = sample_errors(x, pb.C, s);
+  fit.position_after_mm = error_stats(after.position_mm);
+  fit.rotation_after_deg = error_stats(after.rotation_deg);
+  fit.params = fitted_params(pb, x0, x);
   fit.plausible = plausible(x);
   fit.explains = fit.plausible &&
                  fit.position_after_mm.p95 <= o.position_threshold_mm &&
