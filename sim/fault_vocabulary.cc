@@ -150,12 +150,12 @@ std::string fault_help(FaultLayer layer) {
                     [](const FaultKind& k) { return std::string(": ") + k.doc; });
 }
 
-std::vector<FaultItem> parse_faults(const std::string& text, FaultLayer layer) {
-  std::vector<FaultItem> out;
-  const std::string what = std::string(fault_layer_name(layer)) + " fault '";
-  const std::string forms = " (" + fault_forms(layer) + ")";
-  if (text.find_first_not_of(" ,") == std::string::npos) return out;
-  std::vector<std::string> groups;  // named kinds given so far
+namespace {
+
+// The items of a fault list, split at its commas with the spaces dropped
+// (empty items kept: parse_faults names them)
+std::vector<std::string> fault_items(const std::string& text) {
+  std::vector<std::string> items;
   std::string cur;
   for (char c : text + ",") {
     if (c == ' ') continue;
@@ -163,95 +163,158 @@ std::vector<FaultItem> parse_faults(const std::string& text, FaultLayer layer) {
       cur += c;
       continue;
     }
-    std::string item;
-    item.swap(cur);
-    const auto fail = [&](const std::string& why) {
-      throw std::invalid_argument(what + item + "': " + why + forms);
-    };
-    if (item.empty()) fail("empty item in '" + text + "'");
-    const bool timed_layer = layer == kTransportFaults || layer == kWireFaults;
-    FaultItem it;
-    it.text = item;
-    std::string name = item;
-    std::vector<std::string> parts;  // timed: at_s, then the fields
-    if (timed_layer) {
-      const auto at = item.find('@');
-      if (at == std::string::npos) fail("expected kind@at_s[:...]");
-      name = item.substr(0, at);
-      std::string rest = item.substr(at + 1) + ":";
-      std::string p;
-      for (char d : rest) {
-        if (d == ':') {
-          parts.push_back(p);
-          p.clear();
-        } else {
-          p += d;
-        }
-      }
+    items.emplace_back();
+    items.back().swap(cur);
+  }
+  return items;
+}
+
+// Throws std::invalid_argument for one item: "<layer> fault '<item>':
+// <why> (<the layer's forms>)"
+struct ItemFail {
+  const std::string& what;
+  const std::string& item;
+  const std::string& forms;
+  [[noreturn]] void operator()(const std::string& why) const {
+    throw std::invalid_argument(what + item + "': " + why + forms);
+  }
+};
+
+// kind@at_s[:field...]: the kind's name into *name, and at_s and the
+// fields, split at ':', into *parts
+void split_timed(const std::string& item, const ItemFail& fail,
+                 std::string* name, std::vector<std::string>* parts) {
+  const auto at = item.find('@');
+  if (at == std::string::npos) fail("expected kind@at_s[:...]");
+  *name = item.substr(0, at);
+  std::string rest = item.substr(at + 1) + ":";
+  std::string p;
+  for (char d : rest) {
+    if (d == ':') {
+      parts->push_back(p);
+      p.clear();
+    } else {
+      p += d;
     }
-    std::string middle;
-    for (const FaultKind& k : fault_kinds()) {
-      if (!(k.layers & layer) || k.timed != timed_layer) continue;
-      if (k.timed) {
-        if (name == k.name) it.kind = &k;
-      } else {
-        const Pattern pat = split_pattern(k.name);
-        if (!pat.has_field) {
-          if (name == pat.prefix) it.kind = &k;
-        } else if (name.size() > pat.prefix.size() + pat.suffix.size() &&
-                   starts_with(name, pat.prefix) && ends_with(name, pat.suffix)) {
-          // the longest fixed text wins (motor3_relative is not motor<N>_sign)
-          it.kind = &k;
-          middle = name.substr(pat.prefix.size(),
-                               name.size() - pat.prefix.size() - pat.suffix.size());
-        }
-      }
-      if (it.kind != nullptr) break;
-    }
-    if (it.kind == nullptr) {
-      fail(timed_layer ? "unknown kind '" + name + "'" : "unknown name");
-    }
-    const FaultKind& k = *it.kind;
-    std::vector<std::string> values;
+  }
+}
+
+// The layer's kind that `name` is: a timed kind by its name, a named kind
+// by its pattern (the text of its <X> into *middle); nullptr if none
+const FaultKind* find_kind(const std::string& name, FaultLayer layer,
+                           bool timed_layer, std::string* middle) {
+  const FaultKind* kind = nullptr;
+  for (const FaultKind& k : fault_kinds()) {
+    if (!(k.layers & layer) || k.timed != timed_layer) continue;
     if (k.timed) {
-      if (parts.size() != 1 + k.fields.size()) {
-        fail(std::string(k.name) + " takes " + written_form(k));
+      if (name == k.name) kind = &k;
+    } else {
+      const Pattern pat = split_pattern(k.name);
+      if (!pat.has_field) {
+        if (name == pat.prefix) kind = &k;
+      } else if (name.size() > pat.prefix.size() + pat.suffix.size() &&
+                 starts_with(name, pat.prefix) && ends_with(name, pat.suffix)) {
+        // the longest fixed text wins (motor3_relative is not motor<N>_sign)
+        kind = &k;
+        *middle =
+            name.substr(pat.prefix.size(),
+                        name.size() - pat.prefix.size() - pat.suffix.size());
       }
-      values.assign(parts.begin() + 1, parts.end());
-      char* end = nullptr;
-      it.at_s = std::strtod(parts[0].c_str(), &end);
-      if (parts[0].empty() || end != parts[0].c_str() + parts[0].size() ||
-          !std::isfinite(it.at_s)) {
-        fail("at_s '" + parts[0] + "' is not a number");
-      }
-      if (it.at_s < 0.0) fail("at_s '" + parts[0] + "' must be >= 0");
-    } else if (!k.fields.empty()) {
-      values.push_back(middle);
     }
-    for (std::size_t i = 0; i < k.fields.size(); ++i) {
-      const FaultField& f = k.fields[i];
-      const std::string& v = values[i];
-      char* end = nullptr;
-      const double x = std::strtod(v.c_str(), &end);
-      if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(x)) {
-        fail(std::string(f.name) + " '" + v + "' is not a number");
-      }
-      const bool whole_ok = !f.whole || x == std::floor(x);
-      const bool lo_ok = f.lo_open ? x > f.lo : x >= f.lo;
-      const bool hi_ok = std::isinf(f.hi) || (f.lo_open && !f.whole ? x < f.hi : x <= f.hi);
-      if (!whole_ok || !lo_ok || !hi_ok) {
-        fail(std::string(f.name) + " '" + v + "' must be " + rule(f));
-      }
-      it.values.push_back(x);
+    if (kind != nullptr) break;
+  }
+  return kind;
+}
+
+// v read as a number into *x: false unless all of v is one, finite
+bool read_number(const std::string& v, double* x) {
+  char* end = nullptr;
+  *x = std::strtod(v.c_str(), &end);
+  return !v.empty() && end == v.c_str() + v.size() && std::isfinite(*x);
+}
+
+// The text of each of kind k's fields: a timed kind's after its at_s
+// (their count checked, at_s read into it->at_s), a named kind's <X>
+std::vector<std::string> field_texts(const FaultKind& k,
+                                     const std::vector<std::string>& parts,
+                                     const std::string& middle,
+                                     const ItemFail& fail, FaultItem* it) {
+  std::vector<std::string> values;
+  if (k.timed) {
+    if (parts.size() != 1 + k.fields.size()) {
+      fail(std::string(k.name) + " takes " + written_form(k));
     }
-    if (!k.timed) {
-      const std::string group = k.group[0] != '\0' ? k.group : name;
-      for (const std::string& g : groups) {
-        if (g == group) fail(group + " given twice");
-      }
-      groups.push_back(group);
+    values.assign(parts.begin() + 1, parts.end());
+    if (!read_number(parts[0], &it->at_s)) {
+      fail("at_s '" + parts[0] + "' is not a number");
     }
-    out.push_back(std::move(it));
+    if (it->at_s < 0.0) fail("at_s '" + parts[0] + "' must be >= 0");
+  } else if (!k.fields.empty()) {
+    values.push_back(middle);
+  }
+  return values;
+}
+
+// field f's value v, a number that keeps f's rule (rule(f))
+double field_value(const FaultField& f, const std::string& v,
+                   const ItemFail& fail) {
+  double x = 0.0;
+  if (!read_number(v, &x)) {
+    fail(std::string(f.name) + " '" + v + "' is not a number");
+  }
+  const bool whole_ok = !f.whole || x == std::floor(x);
+  const bool lo_ok = f.lo_open ? x > f.lo : x >= f.lo;
+  const bool hi_ok =
+      std::isinf(f.hi) || (f.lo_open && !f.whole ? x < f.hi : x <= f.hi);
+  if (!whole_ok || !lo_ok || !hi_ok) {
+    fail(std::string(f.name) + " '" + v + "' must be " + rule(f));
+  }
+  return x;
+}
+
+// One item of the layer: its kind, at_s and field values. A named kind's
+// group must not be in *groups yet, and is added to it.
+FaultItem parse_item(const std::string& item, FaultLayer layer,
+                     const ItemFail& fail, std::vector<std::string>* groups) {
+  const bool timed_layer = layer == kTransportFaults || layer == kWireFaults;
+  FaultItem it;
+  it.text = item;
+  std::string name = item;
+  std::vector<std::string> parts;  // timed: at_s, then the fields
+  if (timed_layer) split_timed(item, fail, &name, &parts);
+  std::string middle;
+  it.kind = find_kind(name, layer, timed_layer, &middle);
+  if (it.kind == nullptr) {
+    fail(timed_layer ? "unknown kind '" + name + "'" : "unknown name");
+  }
+  const FaultKind& k = *it.kind;
+  const std::vector<std::string> values =
+      field_texts(k, parts, middle, fail, &it);
+  for (std::size_t i = 0; i < k.fields.size(); ++i) {
+    it.values.push_back(field_value(k.fields[i], values[i], fail));
+  }
+  if (!k.timed) {
+    const std::string group = k.group[0] != '\0' ? k.group : name;
+    for (const std::string& g : *groups) {
+      if (g == group) fail(group + " given twice");
+    }
+    groups->push_back(group);
+  }
+  return it;
+}
+
+}  // namespace
+
+std::vector<FaultItem> parse_faults(const std::string& text, FaultLayer layer) {
+  std::vector<FaultItem> out;
+  const std::string what = std::string(fault_layer_name(layer)) + " fault '";
+  const std::string forms = " (" + fault_forms(layer) + ")";
+  if (text.find_first_not_of(" ,") == std::string::npos) return out;
+  std::vector<std::string> groups;  // named kinds given so far
+  for (const std::string& item : fault_items(text)) {
+    const ItemFail fail{what, item, forms};
+    if (item.empty()) fail("empty item in '" + text + "'");
+    out.push_back(parse_item(item, layer, fail, &groups));
   }
   return out;
 }
