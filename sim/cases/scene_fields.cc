@@ -202,47 +202,144 @@ class SceneReader {
     fields.push_back(std::move(f));
   }
 
+  // Where parse() is in one file: its text, its path (for errors) and
+  // the position in the text
+  struct Cursor {
+    const std::string& text;
+    const std::string& path;
+    std::size_t i = 0;
+
+    void skip_space() {
+      while (i < text.size() &&
+             std::isspace(static_cast<unsigned char>(text[i])))
+        ++i;
+    }
+  };
+
+  // Steps over a comment or a processing instruction at c->i (true);
+  // refuses a DTD or CDATA; false at anything else
+  static bool skip_markup(Cursor* c) {
+    const std::string& text = c->text;
+    const std::string& path = c->path;
+    std::size_t& i = c->i;
+    if (text.compare(i, 4, "<!--") == 0) {
+      const std::size_t end = text.find("-->", i + 4);
+      if (end == std::string::npos)
+        fail(path, text, i, "a comment is not closed");
+      i = end + 3;
+      return true;
+    }
+    if (text.compare(i, 2, "<?") == 0) {
+      const std::size_t end = text.find("?>", i + 2);
+      if (end == std::string::npos) fail(path, text, i, "'<?' is not closed");
+      i = end + 2;
+      return true;
+    }
+    if (text.compare(i, 2, "<!") == 0) {
+      fail(path, text, i, "DTDs and CDATA are not MJCF");
+    }
+    return false;
+  }
+
+  // The closing tag at c->i, which must close the innermost open element
+  // (the top of *stack, popped)
+  static void close_element(Cursor* c, std::vector<std::string>* stack,
+                            int* custom_open) {
+    const std::string& text = c->text;
+    const std::string& path = c->path;
+    std::size_t& i = c->i;
+    i += 2;
+    const std::size_t start = i;
+    while (i < text.size() && name_char(text[i])) ++i;
+    const std::string name = text.substr(start, i - start);
+    c->skip_space();
+    if (i >= text.size() || text[i] != '>')
+      fail(path, text, start, "bad closing tag");
+    ++i;
+    if (stack->empty() || stack->back() != name) {
+      fail(path, text, start,
+           "</" + name + "> closes " +
+               (stack->empty() ? "nothing" : "<" + stack->back() + ">"));
+    }
+    if (name == "custom") --*custom_open;
+    stack->pop_back();
+  }
+
+  // One attribute name="value" (or 'value') at c->i of the element
+  // `name`, its value decoded; refused when attrs has it already
+  static Attribute attribute(Cursor* c, const std::string& name,
+                             const std::vector<Attribute>& attrs) {
+    const std::string& text = c->text;
+    const std::string& path = c->path;
+    std::size_t& i = c->i;
+    const std::size_t a = i;
+    while (i < text.size() && name_char(text[i])) ++i;
+    if (i == a)
+      fail(path, text, i,
+           "unexpected '" + std::string(1, text[i]) + "' in <" + name + ">");
+    Attribute attr;
+    attr.name = text.substr(a, i - a);
+    c->skip_space();
+    if (i >= text.size() || text[i] != '=') {
+      fail(path, text, a, "attribute '" + attr.name + "' without a value");
+    }
+    ++i;
+    c->skip_space();
+    if (i >= text.size() || (text[i] != '"' && text[i] != '\'')) {
+      fail(path, text, a, "attribute '" + attr.name + "' is not quoted");
+    }
+    const char quote = text[i++];
+    const std::size_t end = text.find(quote, i);
+    if (end == std::string::npos)
+      fail(path, text, a, "attribute '" + attr.name + "' is not closed");
+    attr.value = decode(text.substr(i, end - i), path, text, a);
+    i = end + 1;
+    for (const Attribute& other : attrs) {
+      if (other.name == attr.name)
+        fail(path, text, a, "attribute '" + attr.name + "' given twice");
+    }
+    return attr;
+  }
+
+  // The attributes of the element `name` opened at `tag`, up to its '>',
+  // or its '/>' (*self_closing)
+  static std::vector<Attribute> attributes(Cursor* c, const std::string& name,
+                                           std::size_t tag,
+                                           bool* self_closing) {
+    const std::string& text = c->text;
+    std::size_t& i = c->i;
+    std::vector<Attribute> attrs;
+    while (true) {
+      c->skip_space();
+      if (i >= text.size())
+        fail(c->path, text, tag, "<" + name + "> is not closed");
+      if (text[i] == '>') {
+        ++i;
+        break;
+      }
+      if (text.compare(i, 2, "/>") == 0) {
+        i += 2;
+        *self_closing = true;
+        break;
+      }
+      attrs.push_back(attribute(c, name, attrs));
+    }
+    return attrs;
+  }
+
   void parse(const std::string& text, const std::string& path,
              bool base_in_custom, int depth) {
+    Cursor c{text, path};
+    std::size_t& i = c.i;
     std::vector<std::string> stack;
     int custom_open = 0;
-    std::size_t i = 0;
-    const auto skip_space = [&] {
-      while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
-    };
     while (true) {
       const std::size_t lt = text.find('<', i);
       if (lt == std::string::npos) break;
       i = lt;
-      if (text.compare(i, 4, "<!--") == 0) {
-        const std::size_t end = text.find("-->", i + 4);
-        if (end == std::string::npos) fail(path, text, i, "a comment is not closed");
-        i = end + 3;
-        continue;
-      }
-      if (text.compare(i, 2, "<?") == 0) {
-        const std::size_t end = text.find("?>", i + 2);
-        if (end == std::string::npos) fail(path, text, i, "'<?' is not closed");
-        i = end + 2;
-        continue;
-      }
-      if (text.compare(i, 2, "<!") == 0) {
-        fail(path, text, i, "DTDs and CDATA are not MJCF");
-      }
+      if (skip_markup(&c)) continue;
       if (text.compare(i, 2, "</") == 0) {
-        i += 2;
-        const std::size_t start = i;
-        while (i < text.size() && name_char(text[i])) ++i;
-        const std::string name = text.substr(start, i - start);
-        skip_space();
-        if (i >= text.size() || text[i] != '>') fail(path, text, start, "bad closing tag");
-        ++i;
-        if (stack.empty() || stack.back() != name) {
-          fail(path, text, start, "</" + name + "> closes " +
-                                      (stack.empty() ? "nothing" : "<" + stack.back() + ">"));
-        }
-        if (name == "custom") --custom_open;
-        stack.pop_back();
+        close_element(&c, &stack, &custom_open);
         continue;
       }
       const std::size_t tag = i;
@@ -251,51 +348,18 @@ class SceneReader {
       while (i < text.size() && name_char(text[i])) ++i;
       const std::string name = text.substr(start, i - start);
       if (name.empty()) fail(path, text, tag, "'<' without an element name");
-      std::vector<Attribute> attrs;
       bool self_closing = false;
-      while (true) {
-        skip_space();
-        if (i >= text.size()) fail(path, text, tag, "<" + name + "> is not closed");
-        if (text[i] == '>') {
-          ++i;
-          break;
-        }
-        if (text.compare(i, 2, "/>") == 0) {
-          i += 2;
-          self_closing = true;
-          break;
-        }
-        const std::size_t a = i;
-        while (i < text.size() && name_char(text[i])) ++i;
-        if (i == a) fail(path, text, i, "unexpected '" + std::string(1, text[i]) + "' in <" + name + ">");
-        Attribute attr;
-        attr.name = text.substr(a, i - a);
-        skip_space();
-        if (i >= text.size() || text[i] != '=') {
-          fail(path, text, a, "attribute '" + attr.name + "' without a value");
-        }
-        ++i;
-        skip_space();
-        if (i >= text.size() || (text[i] != '"' && text[i] != '\'')) {
-          fail(path, text, a, "attribute '" + attr.name + "' is not quoted");
-        }
-        const char quote = text[i++];
-        const std::size_t end = text.find(quote, i);
-        if (end == std::string::npos) fail(path, text, a, "attribute '" + attr.name + "' is not closed");
-        attr.value = decode(text.substr(i, end - i), path, text, a);
-        i = end + 1;
-        for (const Attribute& other : attrs) {
-          if (other.name == attr.name) fail(path, text, a, "attribute '" + attr.name + "' given twice");
-        }
-        attrs.push_back(std::move(attr));
-      }
-      element(name, attrs, base_in_custom || custom_open > 0, depth, path, text, tag);
+      const std::vector<Attribute> attrs =
+          attributes(&c, name, tag, &self_closing);
+      element(name, attrs, base_in_custom || custom_open > 0, depth, path, text,
+              tag);
       if (!self_closing) {
         stack.push_back(name);
         if (name == "custom") ++custom_open;
       }
     }
-    if (!stack.empty()) fail(path, text, text.size(), "<" + stack.back() + "> is not closed");
+    if (!stack.empty())
+      fail(path, text, text.size(), "<" + stack.back() + "> is not closed");
   }
 
   fs::path main_dir_;
