@@ -10,8 +10,9 @@ namespace vmh::sim {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// the emulator's late ring (sim/emulator.h, kMaxLatePeriods) and the most
-// packets a loss or length fault may take (kMaxWireLengthFaultPackets)
+// the emulator's late ring (sim/emulator_faults.h, kMaxLatePeriods) and
+// the most packets a loss or length fault may take
+// (kMaxWireLengthFaultPackets)
 constexpr double kMaxLate = 63;
 constexpr double kMaxPackets = 1e6;
 

@@ -4,12 +4,13 @@
 //   sensor     the case's `fault` field (sim/fault_injector.h): a joint's
 //              sensor reads nan, jumps by 1000 counts, or sticks; its
 //              joint and time are the case fields fault_joint, fault_at_s
-//   transport  `--fault` on the emulator (sim/emulator.h, EmulatorFault):
-//              reads dropped, late, a stalled physics, an unplug
+//   transport  `--fault` on the emulator (sim/emulator_faults.h,
+//              EmulatorFault): reads dropped, late, a stalled physics, an
+//              unplug
 //   wire       `--fault` on emulator:firewire (sim/emulator_firewire.h,
 //              WireFault): packets lost, late, of the wrong length, a bus
 //              reset, an unplug, a stall
-//   seeded     `--emulator-fault` (sim/emulator.h, SeededFaults): a
+//   seeded     `--emulator-fault` (sim/emulator_faults.h, SeededFaults): a
 //              mistake built into the emulated device for a whole session,
 //              for bring-up's `compare` to find
 //
