@@ -294,6 +294,25 @@ void name_kinematics_faults(const ReadingDiagnosis& diag,
   for (SuspectedFault& f : sec->faults) f.recording = dir;
 }
 
+// a panel of the kinematics figure: an error over time, with its p95
+// threshold as a dashed line
+output::Chart error_panel(const std::string& y_label, const std::string& name,
+                          const std::vector<double>& t_s,
+                          const std::vector<double>& error, double threshold) {
+  output::Chart c;
+  c.x.label = "time (s)";
+  c.y.label = y_label;
+  c.series.push_back({name, t_s, error, "", true, false, false});
+  c.series.push_back({"p95 threshold",
+                      {t_s.front(), t_s.back()},
+                      {threshold, threshold},
+                      "#999999",
+                      true,
+                      false,
+                      true});
+  return c;
+}
+
 // kinematics_error.svg: the wrist centre's and the stylus axis's error
 // over time, each with its p95 threshold
 void write_kinematics_figure(const Recording& rec, const std::string& col_text,
@@ -306,33 +325,10 @@ void write_kinematics_figure(const Recording& rec, const std::string& col_text,
   g.title = "Project FK vs the device's transform";
   g.notes = {"recording " + rec.dir,
              "device frame; stylus axis vs the device's " + col_text};
-  output::Chart a;
-  a.x.label = "time (s)";
-  a.y.label = "wrist position error (mm)";
-  a.series.push_back(
-      {"|p_FK - dev_p|", t_s, pos_err_mm, "", true, false, false});
-  a.series.push_back(
-      {"p95 threshold",
-       {t_s.front(), t_s.back()},
-       {kPositionErrorP95ThresholdMm, kPositionErrorP95ThresholdMm},
-       "#999999",
-       true,
-       false,
-       true});
-  output::Chart b;
-  b.x.label = "time (s)";
-  b.y.label = "stylus axis error (deg)";
-  b.series.push_back(
-      {"angle(z_FK, dev axis)", t_s, axis_err_deg, "", true, false, false});
-  b.series.push_back(
-      {"p95 threshold",
-       {t_s.front(), t_s.back()},
-       {kStylusAxisErrorP95ThresholdDeg, kStylusAxisErrorP95ThresholdDeg},
-       "#999999",
-       true,
-       false,
-       true});
-  g.panels = {a, b};
+  g.panels = {error_panel("wrist position error (mm)", "|p_FK - dev_p|", t_s,
+                          pos_err_mm, kPositionErrorP95ThresholdMm),
+              error_panel("stylus axis error (deg)", "angle(z_FK, dev axis)",
+                          t_s, axis_err_deg, kStylusAxisErrorP95ThresholdDeg)};
   sec->figures.push_back(output::write_file_in(
       figure_dir, "kinematics_error.svg", output::chart_grid_svg(g)));
 }
