@@ -27,14 +27,6 @@ using detail::kNan;
 using detail::PulseWindow;
 using detail::response_input;
 
-// t1..t3 of the samples (from sim_start) that are good and within [t0, t1]
-struct Stack {
-  std::vector<double> v;
-  void add(const Joints& q, int n = 3) {
-    for (int i = 0; i < n; ++i) v.push_back(q[i]);
-  }
-};
-
 double dot(const std::vector<double>& a, const std::vector<double>& b) {
   double s = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];

@@ -15,6 +15,7 @@
 #include "sim/closed_loop.h"
 #include "sim/emulator.h"
 #include "sim/emulator_detail.h"
+#include "sim/mujoco_util.h"
 
 namespace vmh::sim {
 namespace {
@@ -24,13 +25,6 @@ namespace {
 // forgiven (the physics thread, like the servo thread, is sometimes a few
 // hundred microseconds late on a loaded host)
 constexpr double kStaleReadPeriods = 3.0;
-
-bool all_finite(const mjtNum* v, int n) {
-  for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(v[i])) return false;
-  }
-  return true;
-}
 
 }  // namespace
 

@@ -6,6 +6,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -74,6 +75,15 @@ int require_id(const mjModel* m, mjtObj type, const char* name,
 std::vector<double> custom_numeric(const mjModel* m, const std::string& name);
 // A <custom><text> field, or nullptr if there is none.
 const char* custom_text(const mjModel* m, const std::string& name);
+
+// Whether the n values at v are all finite (a state MuJoCo can go on
+// from): no allocation, safe on the emulator's physics thread.
+inline bool all_finite(const mjtNum* v, int n) {
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(v[i])) return false;
+  }
+  return true;
+}
 
 }  // namespace vmh::sim
 

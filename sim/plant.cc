@@ -4,18 +4,9 @@
 #include <utility>
 
 #include "sim/cases/case_params_detail.h"
+#include "sim/mujoco_util.h"
 
 namespace vmh::sim {
-namespace {
-
-bool all_finite(const mjtNum* v, int n) {
-  for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(v[i])) return false;
-  }
-  return true;
-}
-
-}  // namespace
 
 std::string PhysicsFault::message() const {
   std::string where = part;
