@@ -10,7 +10,6 @@
 namespace vmh {
 
 using namespace vm_detail;  // NOLINT(build/namespaces)
-using constants::kPi;
 
 namespace {
 

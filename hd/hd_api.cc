@@ -57,7 +57,6 @@ HdDevice* current_device() {
 
 }  // namespace detail
 
-// the registry the library opens devices from (hd_registry.cc)
 }  // namespace vmh::hd
 
 using namespace vmh::hd;          // NOLINT: this file implements the C API

@@ -410,6 +410,8 @@ ClaimTally tally_claims(const std::vector<ReportCase>& cases) {
   return t;
 }
 
+namespace {
+
 // rows: every claim (in the order first met), columns: the cases; a cell
 // is the claim's verdict in that case, linked to its row, or blank where
 // the case does not make that claim
@@ -445,8 +447,6 @@ std::string claim_matrix(const std::vector<ReportCase>& cases) {
   }
   return s + "</table>\n";
 }
-
-namespace {
 
 // The line under the title: how many claims passed, and those that fail
 // or hold on some sides only.
